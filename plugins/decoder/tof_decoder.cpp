@@ -1,0 +1,76 @@
+#include "tof_decoder.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "beaconloc/core/speed_of_sound.hpp"
+
+namespace beaconloc {
+
+const char* to_string(TofRejection r) {
+  switch (r) {
+    case TofRejection::kNonFiniteTof: return "non_finite_tof";
+    case TofRejection::kNegativeTof: return "negative_tof";
+    case TofRejection::kOutOfRangeTof: return "out_of_range_tof";
+    case TofRejection::kBadTemperature: return "bad_temperature";
+    case TofRejection::kNoBeaconMap: return "no_beacon_map";
+    case TofRejection::kUnknownBeacon: return "unknown_beacon";
+    case TofRejection::kStale: return "stale";
+    case TofRejection::kDuplicate: return "duplicate";
+  }
+  return "unknown_reason";
+}
+
+DecodeOutcome TofDecoder::reject(TofRejection r) {
+  counts_.reject(to_string(r));
+  DecodeOutcome out;
+  out.rejection = r;
+  return out;
+}
+
+DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample& tof) {
+  if (!std::isfinite(tof.tof_s)) return reject(TofRejection::kNonFiniteTof);
+  if (!(tof.tof_s > 0.0)) return reject(TofRejection::kNegativeTof);
+  const double t_c = tof.beacon_temperature_c;
+  if (!std::isfinite(t_c) || t_c < config_.min_temperature_c || t_c > config_.max_temperature_c) {
+    return reject(TofRejection::kBadTemperature);
+  }
+  const double range_m = speed_of_sound_mps(t_c) * tof.tof_s;
+  if (range_m < config_.min_range_m || range_m > config_.max_range_m) {
+    return reject(TofRejection::kOutOfRangeTof);
+  }
+  const bool identified = tof.beacon_id != kBeaconUnidentified;
+  if (identified) {
+    if (map_.empty()) return reject(TofRejection::kNoBeaconMap);
+    if (!map_.find(tof.beacon_id)) return reject(TofRejection::kUnknownBeacon);
+  }
+
+  RobotState& robot = robots_[robot_id];
+  if (robot.seen_any && tof.fire_stamp_ns < robot.newest_fire_stamp_ns - config_.max_age_ns) {
+    return reject(TofRejection::kStale);
+  }
+  const auto key = std::make_pair(tof.sequence_number, tof.fire_stamp_ns);
+  if (std::find(robot.recent.begin(), robot.recent.end(), key) != robot.recent.end()) {
+    return reject(TofRejection::kDuplicate);
+  }
+  robot.recent.push_back(key);
+  if (robot.recent.size() > 64) robot.recent.pop_front();
+  robot.newest_fire_stamp_ns =
+      robot.seen_any ? std::max(robot.newest_fire_stamp_ns, tof.fire_stamp_ns) : tof.fire_stamp_ns;
+  robot.seen_any = true;
+
+  DecodedRange out;
+  out.range.stamp_ns = tof.fire_stamp_ns + s_to_ns(tof.tof_s);  // arrival of the pulse
+  out.range.beacon_id = tof.beacon_id;
+  out.range.receiver_id = tof.receiver_id;
+  out.range.range_m = range_m;
+  out.range.variance_m2 = config_.range_sigma_m * config_.range_sigma_m;
+  out.associated = identified;
+  out.source_sequence_number = tof.sequence_number;
+  counts_.accept();
+  DecodeOutcome outcome;
+  outcome.range = out;
+  return outcome;
+}
+
+}  // namespace beaconloc

@@ -1,0 +1,72 @@
+#pragma once
+// The decoder without DDS: RawTof -> BeaconRange. Speed of sound from the temperature the
+// beacon reported (seed 000, Section II-A), range limits, known beacons, freshness. Every
+// rejection is typed and counted.
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "beaconloc/core/beacon_map.hpp"
+#include "beaconloc/core/measurements.hpp"
+#include "beaconloc/core/rejection_counter.hpp"
+
+namespace beaconloc {
+
+enum class TofRejection {
+  kNonFiniteTof,      // NaN or Inf TOF
+  kNegativeTof,       // TOF < 0 (or exactly 0: no flight)
+  kOutOfRangeTof,     // decoded range outside [min_range_m, max_range_m]
+  kBadTemperature,    // NaN/Inf or outside [min_temperature_c, max_temperature_c]
+  kNoBeaconMap,       // an identified beacon before any beacon map arrived
+  kUnknownBeacon,     // beacon id not in the map
+  kStale,             // fired longer ago than max_age_ns before the newest firing of the robot
+  kDuplicate,         // same sequence number and firing stamp seen already
+};
+const char* to_string(TofRejection r);
+
+struct TofDecoderConfig {
+  double min_range_m = 0.1;
+  double max_range_m = 12.0;
+  double range_sigma_m = 0.01;    // seed 000 sigma_dd, measured by the paper
+  double min_temperature_c = -30.0;
+  double max_temperature_c = 60.0;
+  StampNs max_age_ns = 600 * kNsPerMillisecond;  // three 200 ms slots
+};
+
+struct DecodedRange {
+  RangeMeasurement range;
+  bool associated = true;   // false: anonymous pulse, for an estimator that associates
+  float quality = 1.0f;
+  std::uint64_t source_sequence_number = 0;
+};
+
+struct DecodeOutcome {
+  std::optional<DecodedRange> range;
+  std::optional<TofRejection> rejection;
+};
+
+class TofDecoder {
+ public:
+  explicit TofDecoder(TofDecoderConfig config = {}) : config_(config) {}
+  void set_beacon_map(const BeaconMap& map) { map_ = map; }
+  bool has_beacon_map() const { return !map_.empty(); }
+  DecodeOutcome decode(const std::string& robot_id, const RawTofSample& tof);
+  const RejectionCounter& counts() const { return counts_; }
+  const TofDecoderConfig& config() const { return config_; }
+
+ private:
+  DecodeOutcome reject(TofRejection r);
+  struct RobotState {
+    StampNs newest_fire_stamp_ns = 0;
+    bool seen_any = false;
+    std::deque<std::pair<std::uint64_t, StampNs>> recent;  // (sequence, fire stamp)
+  };
+  TofDecoderConfig config_;
+  BeaconMap map_;
+  std::map<std::string, RobotState> robots_;
+  RejectionCounter counts_;
+};
+
+}  // namespace beaconloc

@@ -1,0 +1,34 @@
+#include "scenario.hpp"
+
+#include <cmath>
+
+namespace beaconloc::sim {
+
+Scenario default_scenario() {
+  Scenario s;
+  s.name = "default (seed 000 setup, stadium loop)";
+  const double z_t = 2.011;  // seed 000, trajectories 1-2
+  std::uint32_t id = 1;
+  for (double y : {-0.3, 1.5}) {
+    for (double x : {0.0, 1.5, 3.0}) {
+      s.beacons.push_back({id, {x, y, z_t}, 0});
+      s.firing_order.push_back(id);
+      ++id;
+    }
+  }
+  s.receivers = ReceiverArray::on_circle(0.19, 3);  // seed 000 eq. 1, r_R = 0.19 m
+  // Pioneer P3-DX (the paper's robot); the paper does not print B_w: 0.33 m is the P3-DX's
+  // nominal wheel track (assumption).
+  s.wheel_base_m = 0.33;
+  const double v = 0.34, turn_radius = 0.6, straight = 2.0;
+  const double w = v / turn_radius;
+  s.trajectory = Trajectory({0.5, 0.0, 0.0},
+                            {{straight / v, v, 0.0},
+                             {M_PI / w, v, w},
+                             {straight / v, v, 0.0},
+                             {M_PI / w, v, w}},
+                            /*loop=*/true);
+  return s;
+}
+
+}  // namespace beaconloc::sim

@@ -1,0 +1,181 @@
+#include "range_ekf.hpp"
+
+#include <cmath>
+#include <set>
+
+#include "beaconloc/core/estimator_registry.hpp"
+#include "beaconloc/core/models/diff_drive_motion.hpp"
+#include "beaconloc/core/models/range_model.hpp"
+#include "beaconloc/core/solvers/range_pose_solver.hpp"
+
+namespace beaconloc {
+
+RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
+  RangeEkfParameters p;
+  p.nis_gate = c.parameter("nis_gate", p.nis_gate);
+  p.init_window_s = c.parameter("init_window_s", p.init_window_s);
+  p.init_min_beacons = static_cast<int>(c.parameter("init_min_beacons", p.init_min_beacons));
+  p.max_odometry_gap_s = c.parameter("max_odometry_gap_s", p.max_odometry_gap_s);
+  p.reinitialize_after_gated =
+      static_cast<int>(c.parameter("reinitialize_after_gated", p.reinitialize_after_gated));
+  p.max_range_age_s = c.parameter("max_range_age_s", p.max_range_age_s);
+  return p;
+}
+
+RangeEkf::RangeEkf(const EstimatorConfig& config)
+    : receivers_(config.receivers), params_(RangeEkfParameters::from(config)) {}
+
+InputResult RangeEkf::predict(const OdometrySample& o) {
+  const bool finite = std::isfinite(o.wheel_velocity_right_mps) &&
+                      std::isfinite(o.wheel_velocity_left_mps) && std::isfinite(o.wheel_base_m) &&
+                      o.wheel_velocity_covariance.allFinite();
+  if (!finite) return InputResult::rejected("non_finite_odometry");
+  if (!(o.wheel_base_m > 0.0)) return InputResult::rejected("invalid_wheel_base");
+  if ((o.wheel_velocity_covariance.diagonal().array() < 0.0).any()) {
+    return InputResult::rejected("invalid_odometry_covariance");
+  }
+  if (!last_odometry_stamp_ns_) {  // first sample: the anchor of the odometry time line
+    last_odometry_stamp_ns_ = o.stamp_ns;
+    return InputResult::ok();
+  }
+  if (o.stamp_ns <= *last_odometry_stamp_ns_) {
+    return InputResult::rejected(o.stamp_ns == *last_odometry_stamp_ns_ ? "duplicate_odometry"
+                                                                        : "out_of_order_odometry");
+  }
+  const double dt_s = ns_to_s(o.stamp_ns - *last_odometry_stamp_ns_);
+  last_odometry_stamp_ns_ = o.stamp_ns;
+  if (dt_s > params_.max_odometry_gap_s) {
+    // The velocities describe only the last period; integrating them over the whole gap would
+    // invent motion. The sample re-anchors the time line and the gap is reported.
+    return InputResult::rejected("odometry_gap");
+  }
+  odom_pose_ = predict_diff_drive(odom_pose_, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
+                                  o.wheel_base_m, dt_s)
+                   .pose;
+  if (initialized_) {
+    const DiffDrivePrediction p =
+        predict_diff_drive(ekf_.state(), o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
+                           o.wheel_base_m, dt_s);
+    const Eigen::Matrix2d u = o.wheel_velocity_covariance +
+                              params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity();
+    // Eq. 16: P = J_f,x P J_f,x^T + J_f,u U J_f,u^T.
+    ekf_.predict(p.pose, p.jacobian_pose, p.jacobian_wheels * u * p.jacobian_wheels.transpose());
+  }
+  return InputResult::ok();
+}
+
+InputResult RangeEkf::update(const RangeMeasurement& r) {
+  if (!std::isfinite(r.range_m) || !std::isfinite(r.variance_m2)) {
+    return InputResult::rejected("non_finite_range");
+  }
+  if (!(r.range_m > 0.0) || !(r.variance_m2 > 0.0)) return InputResult::rejected("invalid_range");
+  if (r.beacon_id == kBeaconUnidentified) return InputResult::rejected("unassociated_range");
+  if (map_.empty()) return InputResult::rejected("no_beacon_map");
+  if (!map_.find(r.beacon_id)) return InputResult::rejected("unknown_beacon");
+  if (r.receiver_id >= receivers_.size()) return InputResult::rejected("unknown_receiver");
+  if (last_odometry_stamp_ns_ &&
+      r.stamp_ns < *last_odometry_stamp_ns_ - s_to_ns(params_.max_range_age_s)) {
+    return InputResult::rejected("stale_range");
+  }
+
+  // Every good range joins the window a global fix is computed from.
+  window_.push_back({r, odom_pose_});
+  while (!window_.empty() &&
+         window_.front().range.stamp_ns < r.stamp_ns - s_to_ns(params_.init_window_s)) {
+    window_.pop_front();
+  }
+  if (!initialized_) {
+    try_initialize();
+    return InputResult::ok();
+  }
+  return fuse(r);
+}
+
+// The range is fused at the filter's current time (the newest odometry stamp); the pulse
+// arrived within one odometry period of it (<= 10 ms, 3.4 mm at 0.34 m/s). Fusing delayed ranges
+// at their own stamp by replaying odometry is the job of a later issue.
+InputResult RangeEkf::fuse(const RangeMeasurement& r) {
+  const Beacon& beacon = *map_.find(r.beacon_id);
+  const RangePrediction p = predict_range(ekf_.state(), receivers_.receivers_base_m[r.receiver_id],
+                                          receivers_.receiver_height_m, beacon.position_map_m);
+  const Eigen::Matrix<double, 1, 1> innovation(r.range_m - p.range_m);
+  const Eigen::Matrix<double, 1, 1> noise(r.variance_m2);
+  const UpdateResult result = ekf_.update<1>(innovation, p.jacobian_pose, noise, params_.nis_gate);
+  switch (result.outcome) {
+    case UpdateOutcome::kApplied:
+      ekf_.mutable_state().z() = wrap_angle_rad(ekf_.state().z());
+      consecutive_gated_ = 0;
+      last_correction_stamp_ns_ = std::max(r.stamp_ns, last_odometry_stamp_ns_.value_or(r.stamp_ns));
+      return InputResult::ok();
+    case UpdateOutcome::kSingularInnovation:
+      return InputResult::rejected("singular_innovation");
+    case UpdateOutcome::kGated:
+      break;
+  }
+  if (++consecutive_gated_ >= params_.reinitialize_after_gated) {
+    // The filter no longer agrees with the beacons: start again from a global fix.
+    initialized_ = false;
+    consecutive_gated_ = 0;
+    try_initialize();
+  }
+  return InputResult::rejected("gated_nis");
+}
+
+void RangeEkf::try_initialize() {
+  std::set<std::uint32_t> beacons;
+  for (const auto& b : window_) beacons.insert(b.range.beacon_id);
+  if (static_cast<int>(beacons.size()) < params_.init_min_beacons) return;
+
+  std::vector<RangeObservation> observations;
+  for (const auto& b : window_) {
+    // Where the receiver was, in the frame of the robot now (dead-reckoned odometry).
+    const Pose2 then_in_now = between(odom_pose_, b.odom_pose_at_range);
+    const double travelled_m = then_in_now.head<2>().norm();
+    RangeObservation o;
+    o.receiver_solve_frame_m =
+        transform_point(then_in_now, receivers_.receivers_base_m[b.range.receiver_id]);
+    o.receiver_z_m = receivers_.receiver_height_m;
+    o.beacon_map_m = map_.find(b.range.beacon_id)->position_map_m;
+    o.range_m = b.range.range_m;
+    // Odometry drift over the window adds to the range noise: 2 % of the distance travelled.
+    o.variance_m2 = b.range.variance_m2 + std::pow(0.02 * travelled_m, 2);
+    observations.push_back(o);
+  }
+  const RangePoseSolution fix = solve_pose_from_ranges(observations);
+  if (!fix.ok) return;
+  if (std::sqrt(fix.covariance(0, 0) + fix.covariance(1, 1)) > params_.init_max_position_sigma_m ||
+      std::sqrt(fix.covariance(2, 2)) > params_.init_max_yaw_sigma_rad) {
+    return;  // geometry too weak yet; wait for more beacons
+  }
+  // The fix ignores the correlation the shared odometry introduces: inflate it.
+  const Cov3 p0 = 4.0 * fix.covariance + Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal().toDenseMatrix();
+  ekf_.reset(fix.pose, p0);
+  initialized_ = true;
+  consecutive_gated_ = 0;
+  last_correction_stamp_ns_ = std::max(window_.back().range.stamp_ns,
+                                       last_odometry_stamp_ns_.value_or(window_.back().range.stamp_ns));
+}
+
+std::optional<PoseEstimate> RangeEkf::estimate() const {
+  if (!initialized_ || !last_odometry_stamp_ns_) return std::nullopt;
+  PoseEstimate e;
+  e.stamp_ns = *last_odometry_stamp_ns_;
+  e.pose_map_base = ekf_.state();
+  e.covariance = ekf_.covariance();
+  e.status = status();
+  return e;
+}
+
+PoseStatus RangeEkf::status() const {
+  if (!initialized_) return PoseStatus::kInitializing;
+  return staleness_.classify(last_odometry_stamp_ns_.value_or(last_correction_stamp_ns_),
+                             last_correction_stamp_ns_);
+}
+
+namespace {
+BEACONLOC_REGISTER_ESTIMATOR(
+    "range_ekf", "EKF on [x, y, yaw]: odometry prediction, one update per range, NIS gating",
+    [](const EstimatorConfig& config) { return std::make_unique<RangeEkf>(config); });
+}  // namespace
+
+}  // namespace beaconloc

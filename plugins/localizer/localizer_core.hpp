@@ -1,0 +1,56 @@
+#pragma once
+// The localizer without DDS: one estimator instance per robot id, created on the robot's first
+// sample, and the counts of what was accepted and refused. The participant only converts.
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/rejection_counter.hpp"
+
+namespace beaconloc {
+
+struct LocalizerOutput {
+  std::string robot_id;
+  PoseEstimate estimate;
+  std::vector<std::uint32_t> beacons_used;  // beacons fused since the previous output
+};
+
+class LocalizerCore {
+ public:
+  // Throws UnknownEstimator when no estimator has that name. An empty robot_filter serves
+  // every robot on the topics; otherwise samples of other robots are ignored (and counted).
+  LocalizerCore(std::string estimator_name, EstimatorConfig config, std::string robot_filter = {});
+
+  void set_beacon_map(const BeaconMap& map);
+  bool has_beacon_map() const { return !map_.empty(); }
+  // Predicts; returns the pose to publish once the robot's estimator has one.
+  std::optional<LocalizerOutput> on_odometry(const std::string& robot_id, const OdometrySample& odometry);
+  void on_range(const std::string& robot_id, const RangeMeasurement& range);
+
+  const std::string& estimator_name() const { return estimator_name_; }
+  const RejectionCounter& counts() const { return counts_; }  // reasons prefixed odometry./range.
+  std::size_t robot_count() const { return robots_.size(); }
+  // The worst status over the robots served (kOk when none).
+  PoseStatus worst_status() const;
+
+ private:
+  struct Robot {
+    std::unique_ptr<Estimator> estimator;
+    std::set<std::uint32_t> beacons_used;
+  };
+  Robot* robot(const std::string& robot_id, const char* kind);
+
+  std::string estimator_name_;
+  EstimatorConfig config_;
+  std::string robot_filter_;
+  BeaconMap map_;
+  std::map<std::string, Robot> robots_;
+  RejectionCounter counts_;
+};
+
+}  // namespace beaconloc

@@ -1,0 +1,33 @@
+#pragma once
+// Conversions between the wire types (idl/beaconloc.idl) and the DDS-free core types.
+#include <beaconloc.h>
+
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/beacon_map.hpp"
+#include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/measurements.hpp"
+#include "beaconloc/core/rejection_counter.hpp"
+
+namespace beaconloc::dds {
+
+RawTofSample from_msg(const msg::RawTof& m);
+msg::RawTof to_msg(const std::string& robot_id, const RawTofSample& s);
+
+OdometrySample from_msg(const msg::Odometry& m);
+msg::Odometry to_msg(const std::string& robot_id, const OdometrySample& s, std::uint64_t sequence);
+
+RangeMeasurement from_msg(const msg::BeaconRange& m);
+
+BeaconMap from_msg(const msg::BeaconMap& m);
+msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id);
+
+msg::PoseStatus to_msg(PoseStatus s);
+PoseStatus from_msg(msg::PoseStatus s);
+
+msg::Diagnostics make_diagnostics(const std::string& participant, StampNs stamp_ns,
+                                  const RejectionCounter& counts, std::uint64_t deadline_misses,
+                                  msg::ParticipantStatus status, const std::string& message);
+
+}  // namespace beaconloc::dds

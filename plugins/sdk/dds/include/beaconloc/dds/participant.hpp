@@ -1,0 +1,75 @@
+#pragma once
+// A DomainParticipant with its publisher and subscriber, created from the XML profiles. Owns and
+// deletes every entity it creates. Thin: no logic beyond creating entities with named QoS.
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "beaconloc/dds/topics.hpp"
+
+namespace beaconloc::dds {
+
+struct DdsOptions {
+  int domain_id = 0;
+  // The loopback-only profile keeps every packet on the machine (examples/qos/loopback.xml).
+  std::string participant_profile = "beaconloc.loopback";
+  std::vector<std::string> extra_qos_files;  // loaded after the embedded profiles
+};
+
+class DdsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Loads the embedded profiles, then each extra file. Throws DdsError naming a file that fails.
+void load_qos_profiles(const std::vector<std::string>& extra_files);
+
+class Participant {
+ public:
+  Participant(const DdsOptions& options, const std::string& name);
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+
+  template <class PubSubType>
+  eprosima::fastdds::dds::DataWriter* writer(const TopicSpec& spec,
+                                             eprosima::fastdds::dds::DataWriterListener* listener = nullptr) {
+    return make_writer(topic(spec.name, new PubSubType()), spec.writer_profile, listener);
+  }
+  template <class PubSubType>
+  eprosima::fastdds::dds::DataReader* reader(const TopicSpec& spec,
+                                             eprosima::fastdds::dds::DataReaderListener* listener) {
+    return make_reader(topic(spec.name, new PubSubType()), spec.reader_profile, listener);
+  }
+  const std::string& name() const { return name_; }
+  // Deletes readers and writers first: call before the listeners they use are destroyed.
+  void close();
+
+ private:
+  eprosima::fastdds::dds::Topic* topic(const std::string& name,
+                                       eprosima::fastdds::dds::TopicDataType* type);
+  eprosima::fastdds::dds::DataWriter* make_writer(eprosima::fastdds::dds::Topic* topic,
+                                                  const std::string& profile,
+                                                  eprosima::fastdds::dds::DataWriterListener* l);
+  eprosima::fastdds::dds::DataReader* make_reader(eprosima::fastdds::dds::Topic* topic,
+                                                  const std::string& profile,
+                                                  eprosima::fastdds::dds::DataReaderListener* l);
+
+  std::string name_;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+};
+
+}  // namespace beaconloc::dds

@@ -1,0 +1,125 @@
+#include "beaconloc/dds/convert.hpp"
+
+namespace beaconloc::dds {
+
+RawTofSample from_msg(const msg::RawTof& m) {
+  RawTofSample s;
+  s.beacon_id = m.beacon_id();
+  s.receiver_id = m.receiver_id();
+  s.fire_stamp_ns = m.fire_stamp_ns();
+  s.tof_s = m.tof_s();
+  s.beacon_temperature_c = m.beacon_temperature_c();
+  s.sequence_number = m.sequence_number();
+  return s;
+}
+
+msg::RawTof to_msg(const std::string& robot_id, const RawTofSample& s) {
+  msg::RawTof m;
+  m.robot_id(robot_id);
+  m.beacon_id(s.beacon_id);
+  m.receiver_id(s.receiver_id);
+  m.fire_stamp_ns(s.fire_stamp_ns);
+  m.tof_s(s.tof_s);
+  m.beacon_temperature_c(s.beacon_temperature_c);
+  m.sequence_number(s.sequence_number);
+  return m;
+}
+
+OdometrySample from_msg(const msg::Odometry& m) {
+  OdometrySample s;
+  s.stamp_ns = m.stamp_ns();
+  s.wheel_velocity_right_mps = m.wheel_velocity_right_mps();
+  s.wheel_velocity_left_mps = m.wheel_velocity_left_mps();
+  s.wheel_base_m = m.wheel_base_m();
+  const auto& c = m.wheel_velocity_covariance_m2ps2();
+  s.wheel_velocity_covariance << c[0], c[1], c[2], c[3];
+  return s;
+}
+
+msg::Odometry to_msg(const std::string& robot_id, const OdometrySample& s, std::uint64_t sequence) {
+  msg::Odometry m;
+  m.robot_id(robot_id);
+  m.stamp_ns(s.stamp_ns);
+  m.wheel_velocity_right_mps(s.wheel_velocity_right_mps);
+  m.wheel_velocity_left_mps(s.wheel_velocity_left_mps);
+  m.wheel_base_m(s.wheel_base_m);
+  const auto& c = s.wheel_velocity_covariance;
+  m.wheel_velocity_covariance_m2ps2({c(0, 0), c(0, 1), c(1, 0), c(1, 1)});
+  m.sequence_number(sequence);
+  return m;
+}
+
+RangeMeasurement from_msg(const msg::BeaconRange& m) {
+  RangeMeasurement r;
+  r.stamp_ns = m.stamp_ns();
+  r.beacon_id = m.association() == msg::RANGE_ASSOCIATION_UNASSOCIATED ? kBeaconUnidentified
+                                                                        : m.beacon_id();
+  r.receiver_id = m.receiver_id();
+  r.range_m = m.range_m();
+  r.variance_m2 = m.variance_m2();
+  return r;
+}
+
+BeaconMap from_msg(const msg::BeaconMap& m) {
+  std::vector<Beacon> beacons;
+  for (const auto& b : m.beacons()) {
+    beacons.push_back({b.id(), {b.x_m(), b.y_m(), b.z_m()}, b.group()});
+  }
+  return BeaconMap(beacons);
+}
+
+msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id) {
+  msg::BeaconMap m;
+  m.frame_id(frame_id);
+  for (const auto& b : map.beacons()) {
+    msg::Beacon mb;
+    mb.id(b.id);
+    mb.x_m(b.position_map_m.x());
+    mb.y_m(b.position_map_m.y());
+    mb.z_m(b.position_map_m.z());
+    mb.group(b.group);
+    m.beacons().push_back(mb);
+  }
+  return m;
+}
+
+msg::PoseStatus to_msg(PoseStatus s) {
+  switch (s) {
+    case PoseStatus::kInitializing: return msg::POSE_STATUS_INITIALIZING;
+    case PoseStatus::kOk: return msg::POSE_STATUS_OK;
+    case PoseStatus::kDegraded: return msg::POSE_STATUS_DEGRADED;
+    case PoseStatus::kLost: return msg::POSE_STATUS_LOST;
+  }
+  return msg::POSE_STATUS_LOST;
+}
+
+PoseStatus from_msg(msg::PoseStatus s) {
+  switch (s) {
+    case msg::POSE_STATUS_INITIALIZING: return PoseStatus::kInitializing;
+    case msg::POSE_STATUS_OK: return PoseStatus::kOk;
+    case msg::POSE_STATUS_DEGRADED: return PoseStatus::kDegraded;
+    case msg::POSE_STATUS_LOST: return PoseStatus::kLost;
+  }
+  return PoseStatus::kLost;
+}
+
+msg::Diagnostics make_diagnostics(const std::string& participant, StampNs stamp_ns,
+                                  const RejectionCounter& counts, std::uint64_t deadline_misses,
+                                  msg::ParticipantStatus status, const std::string& message) {
+  msg::Diagnostics d;
+  d.participant(participant);
+  d.stamp_ns(stamp_ns);
+  d.accepted(counts.accepted());
+  for (const auto& [reason, count] : counts.rejected_by_reason()) {
+    msg::RejectionCount rc;
+    rc.reason(reason);
+    rc.count(count);
+    d.rejected().push_back(rc);
+  }
+  d.deadline_misses(deadline_misses);
+  d.status(status);
+  d.message(message);
+  return d;
+}
+
+}  // namespace beaconloc::dds

@@ -1,0 +1,97 @@
+#include "beaconloc/dds/participant.hpp"
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fstream>
+#include <mutex>
+#include <string_view>
+
+namespace beaconloc::embedded {
+extern const std::string_view kLoopbackProfilesXml;
+extern const std::string_view kTopicProfilesXml;
+}  // namespace beaconloc::embedded
+
+namespace beaconloc::dds {
+
+using namespace eprosima::fastdds::dds;
+
+void load_qos_profiles(const std::vector<std::string>& extra_files) {
+  static std::mutex mutex;
+  static bool embedded_loaded = false;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto* factory = DomainParticipantFactory::get_instance();
+  if (!embedded_loaded) {
+    for (std::string_view xml : {embedded::kLoopbackProfilesXml, embedded::kTopicProfilesXml}) {
+      if (factory->load_XML_profiles_string(xml.data(), xml.size()) != ReturnCode_t::RETCODE_OK) {
+        throw DdsError("the embedded QoS profiles failed to load");
+      }
+    }
+    embedded_loaded = true;
+  }
+  for (const auto& file : extra_files) {
+    if (!std::ifstream(file).good()) throw DdsError("QoS file '" + file + "' cannot be read");
+    if (factory->load_XML_profiles_file(file) != ReturnCode_t::RETCODE_OK) {
+      throw DdsError("QoS file '" + file + "' is not a valid Fast DDS profiles file");
+    }
+  }
+}
+
+Participant::Participant(const DdsOptions& options, const std::string& name) : name_(name) {
+  if (options.domain_id < 0 || options.domain_id > 232) {
+    throw DdsError("domain id " + std::to_string(options.domain_id) + " is outside 0..232");
+  }
+  load_qos_profiles(options.extra_qos_files);
+  auto* factory = DomainParticipantFactory::get_instance();
+  DomainParticipantQos qos;
+  if (factory->get_participant_qos_from_profile(options.participant_profile, qos) !=
+      ReturnCode_t::RETCODE_OK) {
+    throw DdsError("participant profile '" + options.participant_profile + "' is not defined");
+  }
+  qos.name(name);
+  participant_ = factory->create_participant(options.domain_id, qos);
+  if (!participant_) throw DdsError("cannot create participant '" + name + "'");
+  publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
+  subscriber_ = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  if (!publisher_ || !subscriber_) throw DdsError("cannot create publisher/subscriber");
+}
+
+Participant::~Participant() {
+  close();
+  if (participant_) {
+    participant_->delete_contained_entities();
+    DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+}
+
+void Participant::close() {
+  if (publisher_) publisher_->delete_contained_entities();
+  if (subscriber_) subscriber_->delete_contained_entities();
+}
+
+Topic* Participant::topic(const std::string& name, TopicDataType* type) {
+  TypeSupport support(type);
+  auto it = topics_.find(name);
+  if (it != topics_.end()) return it->second;
+  if (support.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
+    throw DdsError("cannot register type " + support.get_type_name());
+  }
+  Topic* t = participant_->create_topic(name, support.get_type_name(), TOPIC_QOS_DEFAULT);
+  if (!t) throw DdsError("cannot create topic " + name);
+  topics_[name] = t;
+  return t;
+}
+
+DataWriter* Participant::make_writer(Topic* topic, const std::string& profile,
+                                     DataWriterListener* listener) {
+  DataWriter* w = publisher_->create_datawriter_with_profile(topic, profile, listener);
+  if (!w) throw DdsError("cannot create writer on " + topic->get_name() + " with profile " + profile);
+  return w;
+}
+
+DataReader* Participant::make_reader(Topic* topic, const std::string& profile,
+                                     DataReaderListener* listener) {
+  DataReader* r = subscriber_->create_datareader_with_profile(topic, profile, listener);
+  if (!r) throw DdsError("cannot create reader on " + topic->get_name() + " with profile " + profile);
+  return r;
+}
+
+}  // namespace beaconloc::dds

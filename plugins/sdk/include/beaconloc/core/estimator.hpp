@@ -1,0 +1,71 @@
+#pragma once
+// The estimator plugin API. An estimator is pure maths: it is pushed odometry and ranges
+// (predict / update) and asked for its estimate. It never reads a clock and never includes a
+// DDS header, so the same code runs live, in replay and in tests.
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/beacon_map.hpp"
+#include "beaconloc/core/measurements.hpp"
+#include "beaconloc/core/pose2.hpp"
+#include "beaconloc/core/receiver_array.hpp"
+
+namespace beaconloc {
+
+enum class PoseStatus { kInitializing, kOk, kDegraded, kLost };
+const char* to_string(PoseStatus s);
+
+struct PoseEstimate {
+  StampNs stamp_ns = 0;
+  Pose2 pose_map_base = Pose2::Zero();
+  Cov3 covariance = Cov3::Identity();
+  PoseStatus status = PoseStatus::kInitializing;
+};
+
+// The answer to one pushed input: accepted, or rejected with a reason (counted in Diagnostics).
+struct InputResult {
+  bool accepted = true;
+  std::string rejection;  // empty when accepted; a stable snake_case reason otherwise
+  static InputResult ok() { return {}; }
+  static InputResult rejected(std::string reason) { return {false, std::move(reason)}; }
+};
+
+struct EstimatorConfig {
+  ReceiverArray receivers;
+  std::map<std::string, double> parameters;  // estimator-specific, documented by each plugin
+
+  double parameter(const std::string& name, double fallback) const {
+    auto it = parameters.find(name);
+    return it == parameters.end() ? fallback : it->second;
+  }
+};
+
+class Estimator {
+ public:
+  virtual ~Estimator() = default;
+  virtual std::string name() const = 0;
+  virtual void set_beacon_map(const BeaconMap& map) = 0;
+  virtual InputResult predict(const OdometrySample& odometry) = 0;
+  virtual InputResult update(const RangeMeasurement& range) = 0;
+  // The current pose; nullopt until the estimator has one.
+  virtual std::optional<PoseEstimate> estimate() const = 0;
+  // Status from data time alone (the stamps pushed so far).
+  virtual PoseStatus status() const = 0;
+};
+
+// Status policy shared by estimators: how long without a fused range the pose stays OK.
+struct StalenessPolicy {
+  StampNs degraded_after_ns = 1'000'000'000;   // 5 missed beacon slots
+  StampNs lost_after_ns = 10'000'000'000;
+  PoseStatus classify(StampNs now_ns, StampNs last_correction_ns) const {
+    const StampNs age = now_ns - last_correction_ns;
+    if (age > lost_after_ns) return PoseStatus::kLost;
+    if (age > degraded_after_ns) return PoseStatus::kDegraded;
+    return PoseStatus::kOk;
+  }
+};
+
+}  // namespace beaconloc

@@ -1,0 +1,43 @@
+#pragma once
+// What the estimators are pushed: DDS-free forms of the Odometry and BeaconRange topics.
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "beaconloc/core/time.hpp"
+
+namespace beaconloc {
+
+inline constexpr std::uint32_t kBeaconUnidentified = 0xFFFFFFFFu;
+
+// Wheel velocities held over the odometry interval that ends at stamp_ns (seed 000, eq. 14).
+struct OdometrySample {
+  StampNs stamp_ns = 0;
+  double wheel_velocity_right_mps = 0.0;
+  double wheel_velocity_left_mps = 0.0;
+  double wheel_base_m = 0.0;
+  Eigen::Matrix2d wheel_velocity_covariance = Eigen::Matrix2d::Zero();  // U_k of eq. 16
+};
+
+struct RangeMeasurement {
+  StampNs stamp_ns = 0;  // arrival of the pulse
+  std::uint32_t beacon_id = kBeaconUnidentified;
+  std::uint32_t receiver_id = 0;
+  double range_m = 0.0;
+  double variance_m2 = 0.0;
+};
+
+}  // namespace beaconloc
+
+namespace beaconloc {
+
+// DDS-free form of the RawTof topic: one receiver hearing one beacon firing.
+struct RawTofSample {
+  std::uint32_t beacon_id = kBeaconUnidentified;
+  std::uint32_t receiver_id = 0;
+  StampNs fire_stamp_ns = 0;
+  double tof_s = 0.0;
+  double beacon_temperature_c = 0.0;
+  std::uint64_t sequence_number = 0;
+};
+
+}  // namespace beaconloc

@@ -1,0 +1,32 @@
+#pragma once
+// Planar poses [x_m, y_m, yaw_rad] as Eigen::Vector3d, and SE(2) composition.
+#include <Eigen/Core>
+#include <cmath>
+
+namespace beaconloc {
+
+using Pose2 = Eigen::Vector3d;  // [x_m, y_m, yaw_rad]
+using Cov3 = Eigen::Matrix3d;   // covariance over (x_m, y_m, yaw_rad)
+
+inline double wrap_angle_rad(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
+// Point given in the frame of `pose` expressed in the parent frame.
+inline Eigen::Vector2d transform_point(const Pose2& pose, const Eigen::Vector2d& p) {
+  const double c = std::cos(pose.z()), s = std::sin(pose.z());
+  return {pose.x() + c * p.x() - s * p.y(), pose.y() + s * p.x() + c * p.y()};
+}
+
+// a (+) b: b given in the frame of a.
+inline Pose2 compose(const Pose2& a, const Pose2& b) {
+  const Eigen::Vector2d t = transform_point(a, b.head<2>());
+  return {t.x(), t.y(), wrap_angle_rad(a.z() + b.z())};
+}
+
+// The pose of b expressed in the frame of a: (-a) (+) b.
+inline Pose2 between(const Pose2& a, const Pose2& b) {
+  const double c = std::cos(a.z()), s = std::sin(a.z());
+  const Eigen::Vector2d d = b.head<2>() - a.head<2>();
+  return {c * d.x() + s * d.y(), -s * d.x() + c * d.y(), wrap_angle_rad(b.z() - a.z())};
+}
+
+}  // namespace beaconloc

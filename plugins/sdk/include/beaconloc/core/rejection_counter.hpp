@@ -1,0 +1,30 @@
+#pragma once
+// Counts of accepted inputs and of rejected ones by reason, for a participant's Diagnostics.
+#include <cstdint>
+#include <map>
+#include <string>
+
+namespace beaconloc {
+
+class RejectionCounter {
+ public:
+  void accept() { ++accepted_; }
+  void reject(const std::string& reason) { ++rejected_[reason]; }
+  std::uint64_t accepted() const { return accepted_; }
+  std::uint64_t rejected(const std::string& reason) const {
+    auto it = rejected_.find(reason);
+    return it == rejected_.end() ? 0 : it->second;
+  }
+  std::uint64_t rejected_total() const {
+    std::uint64_t n = 0;
+    for (const auto& [reason, count] : rejected_) n += count;
+    return n;
+  }
+  const std::map<std::string, std::uint64_t>& rejected_by_reason() const { return rejected_; }
+
+ private:
+  std::uint64_t accepted_ = 0;
+  std::map<std::string, std::uint64_t> rejected_;
+};
+
+}  // namespace beaconloc

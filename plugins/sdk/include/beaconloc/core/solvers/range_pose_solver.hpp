@@ -1,0 +1,38 @@
+#pragma once
+// Global pose from ranges alone, no prior: nonlinear least squares (Gauss-Newton) on [x, y, yaw]
+// from several starts. Used to initialize (and re-initialize) filters that track a pose.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/pose2.hpp"
+
+namespace beaconloc {
+
+struct RangeObservation {
+  Eigen::Vector2d receiver_solve_frame_m;  // receiver in the frame of the pose solved for
+  double receiver_z_m = 0.0;
+  Eigen::Vector3d beacon_map_m = Eigen::Vector3d::Zero();
+  double range_m = 0.0;
+  double variance_m2 = 1e-4;
+};
+
+struct RangePoseSolverOptions {
+  int yaw_starts = 12;            // starting headings, evenly spread
+  int position_starts_per_axis = 3;  // grid over the beacons' bounding box
+  int max_iterations = 30;
+  double max_residual_rms_sigma = 3.0;  // accept when the weighted residual RMS is below this
+};
+
+struct RangePoseSolution {
+  bool ok = false;
+  Pose2 pose = Pose2::Zero();
+  Cov3 covariance = Cov3::Identity();  // (J^T R^-1 J)^-1 at the solution
+  double weighted_residual_rms = 0.0;  // residuals in units of their sigma
+  std::string failure;                 // why ok is false
+};
+
+RangePoseSolution solve_pose_from_ranges(const std::vector<RangeObservation>& observations,
+                                         const RangePoseSolverOptions& options = {});
+
+}  // namespace beaconloc
