@@ -111,7 +111,6 @@ void add_decoder_options(CLI::App* app, TofDecoderConfig& o, double& max_age_ms)
 }
 
 void run_until_stopped() {
-  dds::install_stop_handlers();
   while (!dds::wait_for_stop(1s)) {
   }
 }
@@ -180,11 +179,11 @@ int run(int argc, char** argv) {
   monitor->add_option("--out", monitor_out, "write the poses to this CSV");
 
   CLI11_PARSE(app, argc, argv);
+  dds::install_stop_handlers();
 
   try {
     if (gateway->parsed()) {
       GatewayParticipant participant(dds_options, gateway_options, sim::default_scenario());
-      dds::install_stop_handlers();
       participant.start();
       while (!participant.finished() && !dds::wait_for_stop(100ms)) {
       }
@@ -215,7 +214,6 @@ int run(int argc, char** argv) {
       TruthTrack truth;
       if (!monitor_truth.empty()) truth = load_truth_csv(monitor_truth);
       PoseRecorder recorder(dds_options);
-      dds::install_stop_handlers();
       const auto start = std::chrono::steady_clock::now();
       std::size_t shown = 0;
       while (!dds::wait_for_stop(1s)) {
@@ -257,7 +255,6 @@ int run(int argc, char** argv) {
       std::cout << "beaconloc demo: " << sim::default_scenario().name << ", estimator "
                 << localizer_options.estimator << ", " << gateway_options.duration_s
                 << " s simulated at x" << gateway_options.speed << '\n';
-      dds::install_stop_handlers();
       gateway_participant.start();
       double next_report_s = 1.0;
       const auto start = std::chrono::steady_clock::now();

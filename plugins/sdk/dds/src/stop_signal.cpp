@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <initializer_list>
 #include <thread>
 
 namespace beaconloc::dds {
@@ -14,8 +15,9 @@ void install_stop_handlers() {
   struct sigaction action {};
   action.sa_handler = on_stop_signal;
   sigemptyset(&action.sa_mask);
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  // SIGHUP: the terminal went away; SIGPIPE: the reader of our output did (`| head`). Either
+  // way stop cleanly, so that shared-memory segments are released, instead of dying.
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) sigaction(sig, &action, nullptr);
 }
 
 bool stop_requested() { return g_stop.load(); }

@@ -1,5 +1,5 @@
 #pragma once
-// Clean stop on SIGINT/SIGTERM: the handler only sets a flag; loops poll it.
+// Clean stop on SIGINT, SIGTERM, SIGHUP and SIGPIPE: the handler only sets a flag; loops poll it.
 #include <chrono>
 
 namespace beaconloc::dds {

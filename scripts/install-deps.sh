@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Installs every package beaconloc builds and tests with, from Debian 12's archive.
+set -euo pipefail
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update
+$SUDO apt-get install -y --no-install-recommends \
+  ca-certificates cmake g++ ninja-build make \
+  libfastrtps-dev libfastcdr-dev fastddsgen \
+  libeigen3-dev libcli11-dev \
+  libgtest-dev libgmock-dev

@@ -1,0 +1,111 @@
+// gateway, decoder and localizer as three processes on loopback, on a DDS domain of the run's
+// own; this test process records the poses and compares them with the gateway's ground truth.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <stdlib.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "domain_id.hpp"
+#include "pose_recorder.hpp"
+#include "process.hpp"
+
+namespace beaconloc::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+class Pipeline : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char dir[] = "/tmp/beaconloc-pipeline-XXXXXX";
+    ASSERT_NE(::mkdtemp(dir), nullptr);
+    dir_ = dir;
+    dds_.domain_id = domain_.id();
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::vector<std::string> command(const std::string& sub, std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv{BEACONLOC_EXECUTABLE, sub, "--domain", std::to_string(domain_.id())};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return argv;
+  }
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+
+  // Stops a participant the way an operator does, and expects a clean exit.
+  static void stop_cleanly(ChildProcess& p, const char* name) {
+    p.signal(SIGTERM);
+    const auto code = p.wait(15s);
+    ASSERT_TRUE(code) << name << " did not stop on SIGTERM";
+    EXPECT_EQ(*code, 0) << name << " log:\n" << p.log();
+  }
+
+  DomainLease domain_;
+  dds::DdsOptions dds_;
+  std::string dir_;
+};
+
+TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
+  PoseRecorder recorder(dds_);
+  ChildProcess localizer(command("localizer"), path("localizer.log"));
+  ChildProcess decoder(command("decoder"), path("decoder.log"));
+  std::this_thread::sleep_for(1s);  // let the late processes' readers appear first
+  ChildProcess gateway(command("gateway", {"--robot", "robot7", "--duration-s", "22", "--seed", "5",
+                                           "--truth-out", path("truth.csv")}),
+                       path("gateway.log"));
+  const auto gateway_code = gateway.wait(90s);
+  ASSERT_TRUE(gateway_code) << "gateway did not finish";
+  EXPECT_EQ(*gateway_code, 0) << gateway.log();
+  std::this_thread::sleep_for(500ms);
+  stop_cleanly(decoder, "decoder");
+  stop_cleanly(localizer, "localizer");
+
+  const auto poses = recorder.poses();
+  ASSERT_GT(poses.size(), 100u) << "localizer log:\n" << localizer.log();
+  for (const auto& p : poses) ASSERT_EQ(p.robot_id, "robot7");
+  const auto truth = load_truth_csv(path("truth.csv"));
+  const PoseRunSummary s = summarize(poses, truth);
+  const double stamp_span_s = ns_to_s(poses.back().estimate.stamp_ns - poses.front().estimate.stamp_ns);
+  std::printf("multi-process pipeline: %zu poses over %.1f s of motion at %.1f Hz; position RMS %.3f m, "
+              "max %.3f m; heading RMS %.2f deg\n",
+              s.poses, stamp_span_s, s.pose_rate_hz, s.error.position_rms_m(), s.error.position_max_m(),
+              s.error.heading_rms_deg());
+  EXPECT_GE(stamp_span_s, 19.0);  // >= 20 s of motion, less the first global fix
+  EXPECT_GE(s.pose_rate_hz, 90.0);
+  EXPECT_EQ(s.poses_without_truth, 0u);
+  EXPECT_LE(s.error.position_rms_m(), 0.15);
+}
+
+TEST_F(Pipeline, LateJoiningLocalizerGetsTheMapAndLocalizes) {
+  ChildProcess gateway(command("gateway", {"--robot", "late", "--duration-s", "20", "--seed", "6",
+                                           "--truth-out", path("truth.csv")}),
+                       path("gateway.log"));
+  ChildProcess decoder(command("decoder"), path("decoder.log"));
+  std::this_thread::sleep_for(5s);  // the beacon map was written 5 s ago, once
+  PoseRecorder recorder(dds_);
+  ChildProcess localizer(command("localizer"), path("localizer.log"));
+  const auto gateway_code = gateway.wait(90s);
+  ASSERT_TRUE(gateway_code);
+  EXPECT_EQ(*gateway_code, 0) << gateway.log();
+  std::this_thread::sleep_for(500ms);
+  stop_cleanly(decoder, "decoder");
+  stop_cleanly(localizer, "localizer");
+
+  const auto poses = recorder.poses();
+  ASSERT_GT(poses.size(), 100u) << "localizer log:\n" << localizer.log();
+  const auto truth = load_truth_csv(path("truth.csv"));
+  const PoseRunSummary s = summarize(poses, truth);
+  const double stamp_span_s = ns_to_s(poses.back().estimate.stamp_ns - poses.front().estimate.stamp_ns);
+  std::printf("late-joining localizer: %zu poses over %.1f s at %.1f Hz; position RMS %.3f m\n",
+              s.poses, stamp_span_s, s.pose_rate_hz, s.error.position_rms_m());
+  // Started 5 s into a 20 s run: localizing within ~3 s of its start leaves >= 12 s of poses.
+  EXPECT_GE(stamp_span_s, 12.0);
+  EXPECT_EQ(s.poses_without_truth, 0u);
+  EXPECT_GE(s.pose_rate_hz, 90.0);
+  EXPECT_LE(s.error.position_rms_m(), 0.15);
+}
+
+}  // namespace
+}  // namespace beaconloc::testing

@@ -1,0 +1,36 @@
+#pragma once
+// Child processes for multi-process tests: spawn with output to a file, signal, wait.
+#include <sys/types.h>
+
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace beaconloc::testing {
+
+class ChildProcess {
+ public:
+  // Starts argv[0] with the arguments; stdout and stderr go to log_path.
+  ChildProcess(const std::vector<std::string>& argv, const std::string& log_path);
+  ~ChildProcess();  // a child still running is killed (SIGKILL) and reaped
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  pid_t pid() const { return pid_; }
+  void signal(int sig);
+  // The exit code, or 128 + signal; nullopt on timeout.
+  std::optional<int> wait(std::chrono::milliseconds timeout);
+  std::string log() const;
+
+ private:
+  pid_t pid_ = -1;
+  std::optional<int> status_;
+  std::string log_path_;
+};
+
+// Runs to completion and returns (exit code, output).
+std::pair<int, std::string> run_command(const std::vector<std::string>& argv,
+                                        std::chrono::milliseconds timeout);
+
+}  // namespace beaconloc::testing

@@ -1,0 +1,20 @@
+# Fails when a file of the DDS-free core includes a DDS header: the SDK core, the estimators,
+# the decoder and localizer cores and the simulator.
+file(GLOB_RECURSE files
+  ${ROOT}/plugins/sdk/include/beaconloc/core/*
+  ${ROOT}/plugins/sdk/src/*
+  ${ROOT}/plugins/localizer/estimators/*
+  ${ROOT}/plugins/localizer/localizer_core.*
+  ${ROOT}/plugins/decoder/tof_decoder.*
+  ${ROOT}/plugins/gateway/sim/*)
+list(LENGTH files count)
+if(count LESS 10)
+  message(FATAL_ERROR "expected the core's files under ${ROOT}, found ${count}")
+endif()
+foreach(f ${files})
+  file(STRINGS ${f} hits REGEX "#[ \t]*include[ \t]*[<\"](fastdds|fastrtps|fastcdr|beaconloc\\.h|beaconlocPubSubTypes|beaconloc/dds)")
+  if(hits)
+    message(FATAL_ERROR "${f} includes a DDS header: ${hits}")
+  endif()
+endforeach()
+message(STATUS "${count} core files, none includes a DDS header")

@@ -1,0 +1,81 @@
+// The generic EKF: against a textbook linear Kalman filter, gating, singular innovations.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+
+#include "beaconloc/core/filters/ekf.hpp"
+
+namespace beaconloc {
+namespace {
+
+TEST(Ekf, LinearUpdateMatchesKalmanFilter) {
+  Ekf<3> ekf;
+  Eigen::Vector3d x0(1.0, -2.0, 0.5);
+  Eigen::Matrix3d p0;
+  p0 << 0.5, 0.1, 0.0, 0.1, 0.3, 0.05, 0.0, 0.05, 0.2;
+  ekf.reset(x0, p0);
+  Eigen::Matrix<double, 2, 3> h;
+  h << 1.0, 0.5, 0.0, 0.0, -1.0, 2.0;
+  Eigen::Matrix2d r;
+  r << 0.04, 0.01, 0.01, 0.09;
+  const Eigen::Vector2d z(1.4, -0.3);
+  const Eigen::Vector2d nu = z - h * x0;
+  const auto result = ekf.update<2>(nu, h, r, 1e9);
+  ASSERT_EQ(result.outcome, UpdateOutcome::kApplied);
+
+  // Textbook: K = P H^T S^-1, x = x + K nu, P = (I - K H) P.
+  const Eigen::Matrix2d s = h * p0 * h.transpose() + r;
+  const Eigen::Matrix<double, 3, 2> k = p0 * h.transpose() * s.inverse();
+  const Eigen::Vector3d x_expected = x0 + k * nu;
+  const Eigen::Matrix3d p_expected = (Eigen::Matrix3d::Identity() - k * h) * p0;
+  EXPECT_TRUE(ekf.state().isApprox(x_expected, 1e-12));
+  EXPECT_TRUE(ekf.covariance().isApprox(p_expected, 1e-12));
+  EXPECT_NEAR(result.nis, nu.dot(s.inverse() * nu), 1e-12);
+}
+
+TEST(Ekf, PredictPropagatesCovariance) {
+  Ekf<3> ekf;
+  ekf.reset(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity());
+  Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+  f(0, 2) = 0.3;
+  const Eigen::Matrix3d q = 0.01 * Eigen::Matrix3d::Identity();
+  ekf.predict(Eigen::Vector3d(1, 2, 3), f, q);
+  EXPECT_TRUE(ekf.covariance().isApprox(f * f.transpose() + q, 1e-12));
+  EXPECT_EQ(ekf.state(), Eigen::Vector3d(1, 2, 3));
+}
+
+TEST(Ekf, GatesOutliersAndLeavesTheStateAlone) {
+  Ekf<3> ekf;
+  ekf.reset(Eigen::Vector3d::Zero(), 0.01 * Eigen::Matrix3d::Identity());
+  const Eigen::Matrix<double, 1, 3> h(1.0, 0.0, 0.0);
+  const Eigen::Matrix<double, 1, 1> r(0.01);
+  const auto result = ekf.update<1>(Eigen::Matrix<double, 1, 1>(1.0), h, r, 10.83);
+  EXPECT_EQ(result.outcome, UpdateOutcome::kGated);
+  EXPECT_NEAR(result.nis, 1.0 / 0.02, 1e-9);
+  EXPECT_EQ(ekf.state(), Eigen::Vector3d::Zero());
+}
+
+TEST(Ekf, RefusesASingularInnovationCovariance) {
+  Ekf<3> ekf;
+  ekf.reset(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero());
+  const Eigen::Matrix<double, 1, 3> h(1.0, 0.0, 0.0);
+  const auto result = ekf.update<1>(Eigen::Matrix<double, 1, 1>(0.1), h,
+                                    Eigen::Matrix<double, 1, 1>(0.0), 1e9);
+  EXPECT_EQ(result.outcome, UpdateOutcome::kSingularInnovation);
+}
+
+TEST(Ekf, JosephFormKeepsCovarianceSymmetricPositiveDefinite) {
+  Ekf<3> ekf;
+  ekf.reset(Eigen::Vector3d::Zero(), 1e3 * Eigen::Matrix3d::Identity());
+  const Eigen::Matrix<double, 1, 3> h(0.6, 0.8, 0.0);
+  for (int i = 0; i < 1000; ++i) {
+    ekf.update<1>(Eigen::Matrix<double, 1, 1>(0.0), h, Eigen::Matrix<double, 1, 1>(1e-8), 1e12);
+  }
+  const Eigen::Matrix3d p = ekf.covariance();
+  EXPECT_TRUE(p.isApprox(p.transpose(), 0.0) || (p - p.transpose()).norm() < 1e-15);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(p);
+  EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
+}
+
+}  // namespace
+}  // namespace beaconloc
