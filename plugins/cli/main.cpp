@@ -12,6 +12,7 @@
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/dds/stop_signal.hpp"
 #include "decoder_participant.hpp"
+#include "diagnostics_recorder.hpp"
 #include "gateway_participant.hpp"
 #include "localizer_participant.hpp"
 #include "pose_recorder.hpp"
@@ -214,6 +215,7 @@ int run(int argc, char** argv) {
       TruthTrack truth;
       if (!monitor_truth.empty()) truth = load_truth_csv(monitor_truth);
       PoseRecorder recorder(dds_options);
+      DiagnosticsRecorder diagnostics(dds_options);
       const auto start = std::chrono::steady_clock::now();
       std::size_t shown = 0;
       while (!dds::wait_for_stop(1s)) {
@@ -235,6 +237,7 @@ int run(int argc, char** argv) {
       if (!monitor_truth.empty()) truth = load_truth_csv(monitor_truth);  // the gateway kept writing
       const auto poses = recorder.poses();
       if (!monitor_out.empty()) write_poses_csv(monitor_out, poses);
+      print_diagnostics(diagnostics.latest(), std::cout);
       print_summary(summarize(poses, truth), std::cout);
       return 0;
     }
@@ -246,6 +249,7 @@ int run(int argc, char** argv) {
                                      localizer_options.robot));
       DecoderParticipant decoder_participant(dds_options, decoder_config);
       PoseRecorder recorder(dds_options);
+      DiagnosticsRecorder diagnostics(dds_options);
       GatewayParticipant gateway_participant(
           dds_options, gateway_options, sim::default_scenario(),
           [&](StampNs stamp, const Pose2& pose) {
@@ -285,6 +289,7 @@ int run(int argc, char** argv) {
         write_poses_csv(demo_out + "/estimate.csv", poses);
       }
       const PoseRunSummary summary = summarize(poses, truth);
+      print_diagnostics(diagnostics.latest(), std::cout);
       print_summary(summary, std::cout);
       if (summary.error.samples() == 0) {
         std::cerr << "beaconloc demo: no pose was estimated\n";

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "diagnostics_recorder.hpp"
 #include "domain_id.hpp"
 #include "pose_recorder.hpp"
 #include "process.hpp"
@@ -49,6 +50,7 @@ class Pipeline : public ::testing::Test {
 
 TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   PoseRecorder recorder(dds_);
+  DiagnosticsRecorder diagnostics(dds_);
   ChildProcess localizer(command("localizer"), path("localizer.log"));
   ChildProcess decoder(command("decoder"), path("decoder.log"));
   std::this_thread::sleep_for(1s);  // let the late processes' readers appear first
@@ -76,6 +78,17 @@ TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   EXPECT_GE(s.pose_rate_hz, 90.0);
   EXPECT_EQ(s.poses_without_truth, 0u);
   EXPECT_LE(s.error.position_rms_m(), 0.15);
+
+  // Every participant reports what it accepted and refused, by reason.
+  const auto latest = diagnostics.latest();
+  print_diagnostics(latest, std::cout);
+  ASSERT_EQ(latest.count("beaconloc.gateway.robot7"), 1u);
+  ASSERT_EQ(latest.count("beaconloc.decoder"), 1u);
+  ASSERT_EQ(latest.count("beaconloc.localizer.range_ekf"), 1u);
+  const auto& decoder_diag = latest.at("beaconloc.decoder");
+  EXPECT_GT(decoder_diag.accepted(), 250u);   // 15 TOF/s for > 20 s, less the last second
+  EXPECT_TRUE(decoder_diag.rejected().empty());  // the simulated source sends no bad TOF
+  EXPECT_GT(latest.at("beaconloc.localizer.range_ekf").accepted(), 1500u);
 }
 
 TEST_F(Pipeline, LateJoiningLocalizerGetsTheMapAndLocalizes) {
