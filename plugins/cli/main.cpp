@@ -1,7 +1,6 @@
 // beaconloc: one executable, one subcommand per participant (gateway, decoder, localizer), the
 // whole pipeline in one process (demo), and a monitor of the poses.
 #include <CLI/CLI.hpp>
-
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -55,8 +54,7 @@ void add_gateway_options(CLI::App* app, GatewayOptions& o) {
   app->add_option("--robot", o.robot_id, "robot id the samples carry");
   app->add_option("--duration-s", o.duration_s, "simulated seconds to run (0: until stopped)")
       ->check(kNonNegative);
-  app->add_option("--speed", o.speed, "simulated seconds per wall-clock second")
-      ->check(kPositive);
+  app->add_option("--speed", o.speed, "simulated seconds per wall-clock second")->check(kPositive);
   app->add_option("--seed", o.seed, "random seed of the simulated noise");
   app->add_option("--truth-out", o.truth_csv, "write ground truth CSV here");
 }
@@ -105,8 +103,7 @@ void add_localizer_options(CLI::App* app, LocalizerCliOptions& o, bool with_robo
 void add_decoder_options(CLI::App* app, TofDecoderConfig& o, double& max_age_ms) {
   app->add_option("--min-range-m", o.min_range_m, "shortest plausible range")->check(kNonNegative);
   app->add_option("--max-range-m", o.max_range_m, "longest plausible range")->check(kPositive);
-  app->add_option("--range-sigma-m", o.range_sigma_m, "standard deviation of a range")
-      ->check(kPositive);
+  app->add_option("--range-sigma-m", o.range_sigma_m, "standard deviation of a range")->check(kPositive);
   app->add_option("--max-age-ms", max_age_ms, "a TOF fired this long before the newest is stale")
       ->check(kPositive);
 }
@@ -143,7 +140,8 @@ int run(int argc, char** argv) {
   double monitor_duration_s = 0.0;
   std::string monitor_truth, monitor_out;
 
-  auto* gateway = app.add_subcommand("gateway", "beacon-gateway: publish the beacon map, TOFs and odometry (simulated source)");
+  auto* gateway = app.add_subcommand(
+      "gateway", "beacon-gateway: publish the beacon map, TOFs and odometry (simulated source)");
   add_dds_options(gateway, dds_options);
   add_gateway_options(gateway, gateway_options);
   std::string source = "sim";
@@ -153,12 +151,14 @@ int run(int argc, char** argv) {
   add_dds_options(decoder, dds_options);
   add_decoder_options(decoder, decoder_config, max_age_ms);
 
-  auto* localizer = app.add_subcommand("localizer", "localizer: odometry + ranges -> pose, one estimator plugin");
+  auto* localizer =
+      app.add_subcommand("localizer", "localizer: odometry + ranges -> pose, one estimator plugin");
   add_dds_options(localizer, dds_options);
   add_localizer_options(localizer, localizer_options, true);
   localizer->add_flag("--list-estimators", list_estimators, "print the estimators and exit");
 
-  auto* demo = app.add_subcommand("demo", "the whole pipeline in one process on the built-in scenario; prints the accuracy");
+  auto* demo = app.add_subcommand(
+      "demo", "the whole pipeline in one process on the built-in scenario; prints the accuracy");
   add_dds_options(demo, dds_options);
   add_gateway_options(demo, gateway_options);
   add_localizer_options(demo, localizer_options, false);
@@ -172,7 +172,8 @@ int run(int argc, char** argv) {
     }
   });
 
-  auto* monitor = app.add_subcommand("monitor", "print the poses on the bus each second; with --truth, the accuracy at the end");
+  auto* monitor = app.add_subcommand(
+      "monitor", "print the poses on the bus each second; with --truth, the accuracy at the end");
   add_dds_options(monitor, dds_options);
   monitor->add_option("--duration-s", monitor_duration_s, "stop after this many seconds (0: until stopped)")
       ->check(kNonNegative);
@@ -206,8 +207,8 @@ int run(int argc, char** argv) {
         return 0;
       }
       LocalizerParticipant participant(
-          dds_options, LocalizerCore(localizer_options.estimator, localizer_options.config(),
-                                     localizer_options.robot));
+          dds_options,
+          LocalizerCore(localizer_options.estimator, localizer_options.config(), localizer_options.robot));
       run_until_stopped();
       return 0;
     }
@@ -222,10 +223,10 @@ int run(int argc, char** argv) {
         const auto poses = recorder.poses();
         if (poses.size() > shown) {
           const auto& p = poses.back();
-          std::printf("%s %s: %zu poses (+%zu), x %.3f m, y %.3f m, yaw %.1f deg, %s\n",
-                      p.robot_id.c_str(), p.estimator.c_str(), poses.size(), poses.size() - shown,
-                      p.estimate.pose_map_base.x(), p.estimate.pose_map_base.y(),
-                      p.estimate.pose_map_base.z() * 180.0 / M_PI, to_string(p.estimate.status));
+          std::printf("%s %s: %zu poses (+%zu), x %.3f m, y %.3f m, yaw %.1f deg, %s\n", p.robot_id.c_str(),
+                      p.estimator.c_str(), poses.size(), poses.size() - shown, p.estimate.pose_map_base.x(),
+                      p.estimate.pose_map_base.y(), p.estimate.pose_map_base.z() * 180.0 / M_PI,
+                      to_string(p.estimate.status));
           std::fflush(stdout);
           shown = poses.size();
         }
@@ -245,20 +246,19 @@ int run(int argc, char** argv) {
       std::mutex truth_mutex;
       TruthTrack truth;
       LocalizerParticipant localizer_participant(
-          dds_options, LocalizerCore(localizer_options.estimator, localizer_options.config(),
-                                     localizer_options.robot));
+          dds_options,
+          LocalizerCore(localizer_options.estimator, localizer_options.config(), localizer_options.robot));
       DecoderParticipant decoder_participant(dds_options, decoder_config);
       PoseRecorder recorder(dds_options);
       DiagnosticsRecorder diagnostics(dds_options);
-      GatewayParticipant gateway_participant(
-          dds_options, gateway_options, sim::default_scenario(),
-          [&](StampNs stamp, const Pose2& pose) {
-            std::lock_guard<std::mutex> lock(truth_mutex);
-            truth.add(stamp, pose);
-          });
+      GatewayParticipant gateway_participant(dds_options, gateway_options, sim::default_scenario(),
+                                             [&](StampNs stamp, const Pose2& pose) {
+                                               std::lock_guard<std::mutex> lock(truth_mutex);
+                                               truth.add(stamp, pose);
+                                             });
       std::cout << "beaconloc demo: " << sim::default_scenario().name << ", estimator "
-                << localizer_options.estimator << ", " << gateway_options.duration_s
-                << " s simulated at x" << gateway_options.speed << '\n';
+                << localizer_options.estimator << ", " << gateway_options.duration_s << " s simulated at x"
+                << gateway_options.speed << '\n';
       gateway_participant.start();
       double next_report_s = 1.0;
       const auto start = std::chrono::steady_clock::now();

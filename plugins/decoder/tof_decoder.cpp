@@ -9,14 +9,22 @@ namespace beaconloc {
 
 const char* to_string(TofRejection r) {
   switch (r) {
-    case TofRejection::kNonFiniteTof: return "non_finite_tof";
-    case TofRejection::kNegativeTof: return "negative_tof";
-    case TofRejection::kOutOfRangeTof: return "out_of_range_tof";
-    case TofRejection::kBadTemperature: return "bad_temperature";
-    case TofRejection::kNoBeaconMap: return "no_beacon_map";
-    case TofRejection::kUnknownBeacon: return "unknown_beacon";
-    case TofRejection::kStale: return "stale";
-    case TofRejection::kDuplicate: return "duplicate";
+    case TofRejection::kNonFiniteTof:
+      return "non_finite_tof";
+    case TofRejection::kNegativeTof:
+      return "negative_tof";
+    case TofRejection::kOutOfRangeTof:
+      return "out_of_range_tof";
+    case TofRejection::kBadTemperature:
+      return "bad_temperature";
+    case TofRejection::kNoBeaconMap:
+      return "no_beacon_map";
+    case TofRejection::kUnknownBeacon:
+      return "unknown_beacon";
+    case TofRejection::kStale:
+      return "stale";
+    case TofRejection::kDuplicate:
+      return "duplicate";
   }
   return "unknown_reason";
 }

@@ -15,21 +15,21 @@
 namespace beaconloc {
 
 enum class TofRejection {
-  kNonFiniteTof,      // NaN or Inf TOF
-  kNegativeTof,       // TOF < 0 (or exactly 0: no flight)
-  kOutOfRangeTof,     // decoded range outside [min_range_m, max_range_m]
-  kBadTemperature,    // NaN/Inf or outside [min_temperature_c, max_temperature_c]
-  kNoBeaconMap,       // an identified beacon before any beacon map arrived
-  kUnknownBeacon,     // beacon id not in the map
-  kStale,             // fired longer ago than max_age_ns before the newest firing of the robot
-  kDuplicate,         // same sequence number and firing stamp seen already
+  kNonFiniteTof,    // NaN or Inf TOF
+  kNegativeTof,     // TOF < 0 (or exactly 0: no flight)
+  kOutOfRangeTof,   // decoded range outside [min_range_m, max_range_m]
+  kBadTemperature,  // NaN/Inf or outside [min_temperature_c, max_temperature_c]
+  kNoBeaconMap,     // an identified beacon before any beacon map arrived
+  kUnknownBeacon,   // beacon id not in the map
+  kStale,           // fired longer ago than max_age_ns before the newest firing of the robot
+  kDuplicate,       // same sequence number and firing stamp seen already
 };
 const char* to_string(TofRejection r);
 
 struct TofDecoderConfig {
   double min_range_m = 0.1;
   double max_range_m = 12.0;
-  double range_sigma_m = 0.01;    // seed 000 sigma_dd, measured by the paper
+  double range_sigma_m = 0.01;  // seed 000 sigma_dd, measured by the paper
   double min_temperature_c = -30.0;
   double max_temperature_c = 60.0;
   StampNs max_age_ns = 600 * kNsPerMillisecond;  // three 200 ms slots
@@ -37,7 +37,7 @@ struct TofDecoderConfig {
 
 struct DecodedRange {
   RangeMeasurement range;
-  bool associated = true;   // false: anonymous pulse, for an estimator that associates
+  bool associated = true;  // false: anonymous pulse, for an estimator that associates
   float quality = 1.0f;
   std::uint64_t source_sequence_number = 0;
 };

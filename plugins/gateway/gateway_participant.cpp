@@ -20,8 +20,7 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
       participant_(dds, "beaconloc.gateway." + options_.robot_id),
       map_writer_(participant_.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic)),
       tof_writer_(participant_.writer<msg::RawTofPubSubType>(dds::kRawTofTopic)),
-      odometry_writer_(participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic)),
-      diagnostics_writer_(participant_.writer<msg::DiagnosticsPubSubType>(dds::kDiagnosticsTopic)) {
+      odometry_writer_(participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic)) {
   if (!(options_.speed > 0.0)) throw std::invalid_argument("--speed must be > 0");
   if (options_.duration_s < 0.0) throw std::invalid_argument("--duration-s must be >= 0");
   if (!options_.truth_csv.empty()) {
@@ -29,14 +28,24 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
     if (!truth_) throw std::runtime_error("cannot write truth file '" + options_.truth_csv + "'");
     truth_ << "stamp_ns,x_m,y_m,yaw_rad\n" << std::setprecision(10);
   }
+  diagnostics_ = std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] {
+    std::lock_guard<std::mutex> lock(counts_mutex_);
+    return dds::make_diagnostics(
+        participant_.name(), dds::wall_clock_ns(), counts_, 0,
+        counts_.rejected_total() ? msg::PARTICIPANT_STATUS_DEGRADED : msg::PARTICIPANT_STATUS_OK,
+        "simulated source, robot " + options_.robot_id);
+  });
 }
 
 GatewayParticipant::~GatewayParticipant() {
   stop();
+  diagnostics_->stop();
   participant_.close();
 }
 
-void GatewayParticipant::start() { thread_ = std::thread([this] { run(); }); }
+void GatewayParticipant::start() {
+  thread_ = std::thread([this] { run(); });
+}
 
 void GatewayParticipant::stop() {
   stop_ = true;
@@ -47,12 +56,13 @@ void GatewayParticipant::rethrow_failure() const {
   if (!failure_.empty()) throw std::runtime_error(failure_);
 }
 
-void GatewayParticipant::publish_diagnostics() {
-  auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts_, 0,
-                                 counts_.rejected_total() ? msg::PARTICIPANT_STATUS_DEGRADED
-                                                          : msg::PARTICIPANT_STATUS_OK,
-                                 "simulated source, robot " + options_.robot_id);
-  diagnostics_writer_->write(&d);
+void GatewayParticipant::count(bool written) {
+  std::lock_guard<std::mutex> lock(counts_mutex_);
+  if (written) {
+    counts_.accept();
+  } else {
+    counts_.reject("write_failed");
+  }
 }
 
 void GatewayParticipant::run() {
@@ -68,12 +78,11 @@ void GatewayParticipant::run() {
   const StampNs end_ns = options_.duration_s > 0.0 ? s_to_ns(options_.duration_s) : -1;
   const auto wall_start = clock::now();
   std::uint64_t odometry_sequence = 0;
-  std::uint64_t diagnostics_tick = 0;
   for (StampNs sim_ns = step_ns; !stop_ && (end_ns < 0 || sim_ns <= end_ns); sim_ns += step_ns) {
     events.clear();
     source.advance(sim_ns, events);
-    std::this_thread::sleep_until(
-        wall_start + std::chrono::nanoseconds(static_cast<StampNs>(static_cast<double>(sim_ns) / options_.speed)));
+    std::this_thread::sleep_until(wall_start + std::chrono::nanoseconds(static_cast<StampNs>(
+                                                   static_cast<double>(sim_ns) / options_.speed)));
     for (auto& e : events) {
       bool written = false;
       if (e.kind == sim::SimEvent::Kind::kTof) {
@@ -91,22 +100,14 @@ void GatewayParticipant::run() {
         }
         if (on_truth_) on_truth_(stamp, e.truth_map_base);
       }
-      if (written) {
-        counts_.accept();
-      } else {
-        counts_.reject("write_failed");
-      }
-    }
-    if (static_cast<std::uint64_t>(sim_ns / kNsPerSecond) != diagnostics_tick) {  // once per simulated second
-      diagnostics_tick = static_cast<std::uint64_t>(sim_ns / kNsPerSecond);
-      publish_diagnostics();
+      count(written);
     }
   }
   if (truth_) {
     truth_.flush();
     if (!truth_) failure_ = "writing truth file '" + options_.truth_csv + "' failed";
   }
-  publish_diagnostics();
+  diagnostics_->publish_now();
   finished_ = true;
 }
 

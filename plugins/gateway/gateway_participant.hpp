@@ -6,11 +6,13 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 
-#include "beaconloc/dds/participant.hpp"
 #include "beaconloc/core/rejection_counter.hpp"
+#include "beaconloc/dds/diagnostics_publisher.hpp"
+#include "beaconloc/dds/participant.hpp"
 #include "sim/scenario.hpp"
 
 namespace beaconloc {
@@ -20,7 +22,7 @@ struct GatewayOptions {
   double duration_s = 0.0;  // simulated seconds to run; 0 = until stopped
   double speed = 1.0;       // simulated seconds per wall second
   std::uint64_t seed = 1;
-  std::string truth_csv;    // ground truth written here when not empty
+  std::string truth_csv;  // ground truth written here when not empty
   std::string frame_id = "map";
 };
 
@@ -40,7 +42,7 @@ class GatewayParticipant {
 
  private:
   void run();
-  void publish_diagnostics();
+  void count(bool written);
 
   GatewayOptions options_;
   sim::Scenario scenario_;
@@ -49,9 +51,10 @@ class GatewayParticipant {
   eprosima::fastdds::dds::DataWriter* map_writer_;
   eprosima::fastdds::dds::DataWriter* tof_writer_;
   eprosima::fastdds::dds::DataWriter* odometry_writer_;
-  eprosima::fastdds::dds::DataWriter* diagnostics_writer_;
   std::ofstream truth_;
+  std::mutex counts_mutex_;
   RejectionCounter counts_;  // accepted = samples written; rejected = write failures
+  std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> finished_{false};
   std::string failure_;

@@ -4,8 +4,7 @@
 
 namespace beaconloc {
 
-LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
-                             std::string robot_filter)
+LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config, std::string robot_filter)
     : estimator_name_(std::move(estimator_name)),
       config_(std::move(config)),
       robot_filter_(std::move(robot_filter)) {
@@ -70,10 +69,14 @@ PoseStatus LocalizerCore::worst_status() const {
   PoseStatus worst = PoseStatus::kOk;
   auto rank = [](PoseStatus s) {
     switch (s) {
-      case PoseStatus::kOk: return 0;
-      case PoseStatus::kInitializing: return 1;
-      case PoseStatus::kDegraded: return 2;
-      case PoseStatus::kLost: return 3;
+      case PoseStatus::kOk:
+        return 0;
+      case PoseStatus::kInitializing:
+        return 1;
+      case PoseStatus::kDegraded:
+        return 2;
+      case PoseStatus::kLost:
+        return 3;
     }
     return 3;
   };

@@ -2,34 +2,16 @@
 
 #include <beaconlocPubSubTypes.h>
 
-#include <fastdds/dds/subscriber/SampleInfo.hpp>
-
 namespace beaconloc {
 
-using eprosima::fastdds::dds::DataReader;
-using eprosima::fastdds::dds::SampleInfo;
-
-class DiagnosticsRecorder::Listener : public eprosima::fastdds::dds::DataReaderListener {
- public:
-  explicit Listener(DiagnosticsRecorder& owner) : owner_(owner) {}
-  void on_data_available(DataReader* reader) override {
-    msg::Diagnostics m;
-    SampleInfo info;
-    while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
-      std::lock_guard<std::mutex> lock(owner_.mutex_);
-      owner_.latest_[m.participant()] = m;
-    }
-  }
-
- private:
-  DiagnosticsRecorder& owner_;
-};
-
 DiagnosticsRecorder::DiagnosticsRecorder(const dds::DdsOptions& dds)
-    : listener_(std::make_unique<Listener>(*this)),
-      participant_(dds, "beaconloc.diagnostics_recorder"),
-      reader_(participant_.reader<msg::DiagnosticsPubSubType>(dds::kDiagnosticsTopic, listener_.get())) {}
+    : participant_(dds, "beaconloc.diagnostics_recorder") {
+  participant_.subscribe<msg::DiagnosticsPubSubType>(dds::kDiagnosticsTopic,
+                                                     [this](const msg::Diagnostics& m) {
+                                                       std::lock_guard<std::mutex> lock(mutex_);
+                                                       latest_[m.participant()] = m;
+                                                     });
+}
 
 DiagnosticsRecorder::~DiagnosticsRecorder() { participant_.close(); }
 

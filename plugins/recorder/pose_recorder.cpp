@@ -2,50 +2,24 @@
 
 #include <beaconlocPubSubTypes.h>
 
-#include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <fstream>
-#include <iomanip>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iomanip>
 #include <stdexcept>
 
 #include "beaconloc/dds/convert.hpp"
 
 namespace beaconloc {
 
-using eprosima::fastdds::dds::DataReader;
-using eprosima::fastdds::dds::SampleInfo;
-
-class PoseRecorder::Listener : public eprosima::fastdds::dds::DataReaderListener {
- public:
-  explicit Listener(PoseRecorder& owner) : owner_(owner) {}
-  void on_data_available(DataReader* reader) override {
-    msg::PoseEstimate m;
-    SampleInfo info;
-    while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
-      RecordedPose p;
-      p.robot_id = m.robot_id();
-      p.estimate.stamp_ns = m.stamp_ns();
-      p.estimate.pose_map_base = {m.x_m(), m.y_m(), m.yaw_rad()};
-      p.estimate.covariance =
-          Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m.covariance().data());
-      p.estimate.status = dds::from_msg(m.status());
-      p.estimator = m.estimator();
-      p.received = std::chrono::steady_clock::now();
-      std::lock_guard<std::mutex> lock(owner_.mutex_);
-      owner_.poses_.push_back(std::move(p));
-    }
-  }
-
- private:
-  PoseRecorder& owner_;
-};
-
-PoseRecorder::PoseRecorder(const dds::DdsOptions& dds)
-    : listener_(std::make_unique<Listener>(*this)),
-      participant_(dds, "beaconloc.pose_recorder"),
-      reader_(participant_.reader<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic, listener_.get())) {}
+PoseRecorder::PoseRecorder(const dds::DdsOptions& dds) : participant_(dds, "beaconloc.pose_recorder") {
+  participant_.subscribe<msg::PoseEstimatePubSubType>(
+      dds::kPoseEstimateTopic, [this](const msg::PoseEstimate& m) {
+        RecordedPose p{m.robot_id(), dds::from_msg(m), m.estimator(), std::chrono::steady_clock::now()};
+        std::lock_guard<std::mutex> lock(mutex_);
+        poses_.push_back(std::move(p));
+      });
+}
 
 PoseRecorder::~PoseRecorder() { participant_.close(); }
 
@@ -60,8 +34,8 @@ void write_poses_csv(const std::string& path, const std::vector<RecordedPose>& p
   out << "robot_id,stamp_ns,x_m,y_m,yaw_rad,cov_xx,cov_yy,cov_yawyaw,status\n" << std::setprecision(10);
   for (const auto& p : poses) {
     const auto& e = p.estimate;
-    out << p.robot_id << ',' << e.stamp_ns << ',' << e.pose_map_base.x() << ',' << e.pose_map_base.y()
-        << ',' << e.pose_map_base.z() << ',' << e.covariance(0, 0) << ',' << e.covariance(1, 1) << ','
+    out << p.robot_id << ',' << e.stamp_ns << ',' << e.pose_map_base.x() << ',' << e.pose_map_base.y() << ','
+        << e.pose_map_base.z() << ',' << e.covariance(0, 0) << ',' << e.covariance(1, 1) << ','
         << e.covariance(2, 2) << ',' << to_string(e.status) << '\n';
   }
   if (!out.flush()) throw std::runtime_error("writing '" + path + "' failed");

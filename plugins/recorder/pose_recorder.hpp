@@ -26,12 +26,9 @@ class PoseRecorder {
   std::vector<RecordedPose> poses() const;
 
  private:
-  class Listener;
   mutable std::mutex mutex_;
   std::vector<RecordedPose> poses_;
-  std::unique_ptr<Listener> listener_;
   dds::Participant participant_;
-  eprosima::fastdds::dds::DataReader* reader_;
 };
 
 // Writes poses as CSV: robot_id,stamp_ns,x_m,y_m,yaw_rad,cov_xx,cov_yy,cov_yawyaw,status.
@@ -50,8 +47,8 @@ TruthTrack load_truth_csv(const std::string& path);
 
 struct PoseRunSummary {
   std::size_t poses = 0;
-  double pose_rate_hz = 0.0;        // poses / arrival time span
-  PoseErrorAccumulator error;       // over poses whose stamp the truth covers
+  double pose_rate_hz = 0.0;   // poses / arrival time span
+  PoseErrorAccumulator error;  // over poses whose stamp the truth covers
   std::size_t poses_without_truth = 0;
 };
 PoseRunSummary summarize(const std::vector<RecordedPose>& poses, const TruthTrack& truth);

@@ -87,8 +87,8 @@ TEST(Cli, ParticipantsStopCleanlyOnSigintAndSigterm) {
 
 TEST(Cli, DemoEndsWithThePositionRmsAgainstGroundTruth) {
   DomainLease domain;
-  auto [code, out] = beaconloc({"demo", "--domain", std::to_string(domain.id()), "--duration-s", "12",
-                                "--speed", "4"});
+  auto [code, out] =
+      beaconloc({"demo", "--domain", std::to_string(domain.id()), "--duration-s", "12", "--speed", "4"});
   EXPECT_EQ(code, 0) << out;
   const auto at = out.rfind("position RMS ");
   ASSERT_NE(at, std::string::npos) << out;

@@ -43,6 +43,16 @@ class Pipeline : public ::testing::Test {
     EXPECT_EQ(*code, 0) << name << " log:\n" << p.log();
   }
 
+  // Waits for the gateway to finish its run, lets the last samples through, stops the others.
+  static void finish_run(ChildProcess& gateway, ChildProcess& decoder, ChildProcess& localizer) {
+    const auto gateway_code = gateway.wait(90s);
+    ASSERT_TRUE(gateway_code) << "gateway did not finish";
+    EXPECT_EQ(*gateway_code, 0) << gateway.log();
+    std::this_thread::sleep_for(500ms);
+    stop_cleanly(decoder, "decoder");
+    stop_cleanly(localizer, "localizer");
+  }
+
   DomainLease domain_;
   dds::DdsOptions dds_;
   std::string dir_;
@@ -57,12 +67,7 @@ TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   ChildProcess gateway(command("gateway", {"--robot", "robot7", "--duration-s", "22", "--seed", "5",
                                            "--truth-out", path("truth.csv")}),
                        path("gateway.log"));
-  const auto gateway_code = gateway.wait(90s);
-  ASSERT_TRUE(gateway_code) << "gateway did not finish";
-  EXPECT_EQ(*gateway_code, 0) << gateway.log();
-  std::this_thread::sleep_for(500ms);
-  stop_cleanly(decoder, "decoder");
-  stop_cleanly(localizer, "localizer");
+  ASSERT_NO_FATAL_FAILURE(finish_run(gateway, decoder, localizer));
 
   const auto poses = recorder.poses();
   ASSERT_GT(poses.size(), 100u) << "localizer log:\n" << localizer.log();
@@ -70,10 +75,11 @@ TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   const auto truth = load_truth_csv(path("truth.csv"));
   const PoseRunSummary s = summarize(poses, truth);
   const double stamp_span_s = ns_to_s(poses.back().estimate.stamp_ns - poses.front().estimate.stamp_ns);
-  std::printf("multi-process pipeline: %zu poses over %.1f s of motion at %.1f Hz; position RMS %.3f m, "
-              "max %.3f m; heading RMS %.2f deg\n",
-              s.poses, stamp_span_s, s.pose_rate_hz, s.error.position_rms_m(), s.error.position_max_m(),
-              s.error.heading_rms_deg());
+  std::printf(
+      "multi-process pipeline: %zu poses over %.1f s of motion at %.1f Hz; position RMS %.3f m, "
+      "max %.3f m; heading RMS %.2f deg\n",
+      s.poses, stamp_span_s, s.pose_rate_hz, s.error.position_rms_m(), s.error.position_max_m(),
+      s.error.heading_rms_deg());
   EXPECT_GE(stamp_span_s, 19.0);  // >= 20 s of motion, less the first global fix
   EXPECT_GE(s.pose_rate_hz, 90.0);
   EXPECT_EQ(s.poses_without_truth, 0u);
@@ -86,7 +92,7 @@ TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   ASSERT_EQ(latest.count("beaconloc.decoder"), 1u);
   ASSERT_EQ(latest.count("beaconloc.localizer.range_ekf"), 1u);
   const auto& decoder_diag = latest.at("beaconloc.decoder");
-  EXPECT_GT(decoder_diag.accepted(), 250u);   // 15 TOF/s for > 20 s, less the last second
+  EXPECT_GT(decoder_diag.accepted(), 250u);      // 15 TOF/s for > 20 s, less the last second
   EXPECT_TRUE(decoder_diag.rejected().empty());  // the simulated source sends no bad TOF
   EXPECT_GT(latest.at("beaconloc.localizer.range_ekf").accepted(), 1500u);
 }
@@ -99,20 +105,15 @@ TEST_F(Pipeline, LateJoiningLocalizerGetsTheMapAndLocalizes) {
   std::this_thread::sleep_for(5s);  // the beacon map was written 5 s ago, once
   PoseRecorder recorder(dds_);
   ChildProcess localizer(command("localizer"), path("localizer.log"));
-  const auto gateway_code = gateway.wait(90s);
-  ASSERT_TRUE(gateway_code);
-  EXPECT_EQ(*gateway_code, 0) << gateway.log();
-  std::this_thread::sleep_for(500ms);
-  stop_cleanly(decoder, "decoder");
-  stop_cleanly(localizer, "localizer");
+  ASSERT_NO_FATAL_FAILURE(finish_run(gateway, decoder, localizer));
 
   const auto poses = recorder.poses();
   ASSERT_GT(poses.size(), 100u) << "localizer log:\n" << localizer.log();
   const auto truth = load_truth_csv(path("truth.csv"));
   const PoseRunSummary s = summarize(poses, truth);
   const double stamp_span_s = ns_to_s(poses.back().estimate.stamp_ns - poses.front().estimate.stamp_ns);
-  std::printf("late-joining localizer: %zu poses over %.1f s at %.1f Hz; position RMS %.3f m\n",
-              s.poses, stamp_span_s, s.pose_rate_hz, s.error.position_rms_m());
+  std::printf("late-joining localizer: %zu poses over %.1f s at %.1f Hz; position RMS %.3f m\n", s.poses,
+              stamp_span_s, s.pose_rate_hz, s.error.position_rms_m());
   // Started 5 s into a 20 s run: localizing within ~3 s of its start leaves >= 12 s of poses.
   EXPECT_GE(stamp_span_s, 12.0);
   EXPECT_EQ(s.poses_without_truth, 0u);

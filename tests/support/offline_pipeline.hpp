@@ -3,7 +3,9 @@
 // LocalizerCore, with every pose compared to the simulator's truth.
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "beaconloc/core/pose_error.hpp"
 #include "localizer_core.hpp"
@@ -12,12 +14,47 @@
 
 namespace beaconloc::testing {
 
+inline std::vector<sim::SimEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed,
+                                           double duration_s) {
+  sim::SimSource source(scenario, seed);
+  std::vector<sim::SimEvent> events;
+  source.advance(s_to_ns(duration_s), events);
+  return events;
+}
+
+// Decoder and localizer cores wired as the participants wire them, knowing the scenario's map.
+struct OfflineStack {
+  explicit OfflineStack(const sim::Scenario& scenario, const std::string& estimator = "range_ekf")
+      : localizer(estimator, config_for(scenario)) {
+    localizer.set_beacon_map(BeaconMap(scenario.beacons));
+    decoder.set_beacon_map(BeaconMap(scenario.beacons));
+  }
+  // One simulated event in; the pose the localizer would publish, on odometry events.
+  std::optional<LocalizerOutput> feed(const std::string& robot_id, const sim::SimEvent& e) {
+    if (e.kind == sim::SimEvent::Kind::kTof) {
+      if (const auto out = decoder.decode(robot_id, e.tof); out.range) {
+        localizer.on_range(robot_id, out.range->range);
+      }
+      return std::nullopt;
+    }
+    return localizer.on_odometry(robot_id, e.odometry);
+  }
+  static EstimatorConfig config_for(const sim::Scenario& scenario) {
+    EstimatorConfig config;
+    config.receivers = scenario.receivers;
+    return config;
+  }
+
+  LocalizerCore localizer;
+  TofDecoder decoder;
+};
+
 struct OfflineRun {
-  PoseErrorAccumulator error;      // over every pose after start_after_s + settle_s
+  PoseErrorAccumulator error;  // over every pose after start_after_s + settle_s
   std::size_t poses = 0;
   std::size_t nees_steps = 0;
-  std::size_t nees_in_band = 0;    // NEES (3 dof) within the two-sided 95 % chi-square band
-  double first_pose_s = -1.0;      // sim time of the first pose
+  std::size_t nees_in_band = 0;  // NEES (3 dof) within the two-sided 95 % chi-square band
+  double first_pose_s = -1.0;    // sim time of the first pose
   RejectionCounter decoder_counts;
   RejectionCounter localizer_counts;
 
@@ -27,28 +64,14 @@ struct OfflineRun {
 };
 
 inline OfflineRun run_offline(const sim::Scenario& scenario, std::uint64_t seed, double duration_s,
-                              const std::string& estimator = "range_ekf",
-                              double start_after_s = 0.0, double settle_s = 2.0) {
-  EstimatorConfig config;
-  config.receivers = scenario.receivers;
-  LocalizerCore localizer(estimator, config);
-  localizer.set_beacon_map(BeaconMap(scenario.beacons));
-  TofDecoder decoder;
-  decoder.set_beacon_map(BeaconMap(scenario.beacons));
-  sim::SimSource source(scenario, seed);
-  std::vector<sim::SimEvent> events;
-  source.advance(s_to_ns(duration_s), events);
-
+                              const std::string& estimator = "range_ekf", double start_after_s = 0.0,
+                              double settle_s = 2.0) {
+  OfflineStack stack(scenario, estimator);
   OfflineRun run;
   const StampNs start_ns = s_to_ns(start_after_s);
-  for (const auto& e : events) {
+  for (const auto& e : simulate(scenario, seed, duration_s)) {
     if (e.stamp_ns < start_ns) continue;  // a localizer that joins late has seen nothing before
-    if (e.kind == sim::SimEvent::Kind::kTof) {
-      const auto out = decoder.decode("robot", e.tof);
-      if (out.range) localizer.on_range("robot", out.range->range);
-      continue;
-    }
-    const auto pose = localizer.on_odometry("robot", e.odometry);
+    const auto pose = stack.feed("robot", e);
     if (!pose) continue;
     ++run.poses;
     if (run.first_pose_s < 0.0) run.first_pose_s = ns_to_s(e.stamp_ns);
@@ -62,8 +85,8 @@ inline OfflineRun run_offline(const sim::Scenario& scenario, std::uint64_t seed,
     // chi-square, 3 dof: 2.5 % and 97.5 % quantiles
     if (nees >= 0.2158 && nees <= 9.3484) ++run.nees_in_band;
   }
-  run.decoder_counts = decoder.counts();
-  run.localizer_counts = localizer.counts();
+  run.decoder_counts = stack.decoder.counts();
+  run.localizer_counts = stack.localizer.counts();
   return run;
 }
 

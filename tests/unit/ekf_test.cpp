@@ -1,9 +1,9 @@
 // The generic EKF: against a textbook linear Kalman filter, gating, singular innovations.
+#include "beaconloc/core/filters/ekf.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
-
-#include "beaconloc/core/filters/ekf.hpp"
 
 namespace beaconloc {
 namespace {
@@ -59,8 +59,8 @@ TEST(Ekf, RefusesASingularInnovationCovariance) {
   Ekf<3> ekf;
   ekf.reset(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero());
   const Eigen::Matrix<double, 1, 3> h(1.0, 0.0, 0.0);
-  const auto result = ekf.update<1>(Eigen::Matrix<double, 1, 1>(0.1), h,
-                                    Eigen::Matrix<double, 1, 1>(0.0), 1e9);
+  const auto result =
+      ekf.update<1>(Eigen::Matrix<double, 1, 1>(0.1), h, Eigen::Matrix<double, 1, 1>(0.0), 1e9);
   EXPECT_EQ(result.outcome, UpdateOutcome::kSingularInnovation);
 }
 

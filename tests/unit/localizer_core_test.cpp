@@ -1,13 +1,13 @@
 // The localizer core: one estimator per robot on shared topics, robot filtering, counts.
+#include "localizer_core.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <set>
 
 #include "beaconloc/core/estimator_registry.hpp"
-#include "localizer_core.hpp"
-#include "sim/sim_source.hpp"
-#include "tof_decoder.hpp"
+#include "offline_pipeline.hpp"
 
 namespace beaconloc {
 namespace {
@@ -19,25 +19,15 @@ TEST(LocalizerCore, UnknownEstimatorFailsAtConstruction) {
 TEST(LocalizerCore, KeepsRobotsApartOnSharedTopics) {
   // Two robots on the same path 7 s apart in time; each must be tracked by its own estimator.
   const sim::Scenario scenario = sim::default_scenario();
-  EstimatorConfig config;
-  config.receivers = scenario.receivers;
-  LocalizerCore core("range_ekf", config);
-  core.set_beacon_map(BeaconMap(scenario.beacons));
-  TofDecoder decoder;
-  decoder.set_beacon_map(BeaconMap(scenario.beacons));
-  sim::SimSource a(scenario, 1), b(scenario, 2);
-  std::vector<sim::SimEvent> ea, eb;
-  a.advance(s_to_ns(20.0), ea);
-  b.advance(s_to_ns(27.0), eb);
-  eb.erase(eb.begin(), std::find_if(eb.begin(), eb.end(), [](const auto& e) { return e.stamp_ns > s_to_ns(7.0); }));
+  testing::OfflineStack stack(scenario);
+  const auto ea = testing::simulate(scenario, 1, 20.0);
+  auto eb = testing::simulate(scenario, 2, 27.0);
+  eb.erase(eb.begin(),
+           std::find_if(eb.begin(), eb.end(), [](const auto& e) { return e.stamp_ns > s_to_ns(7.0); }));
   double worst = 0.0;
   std::set<std::uint32_t> used;
   auto feed = [&](const std::string& robot, const sim::SimEvent& e) {
-    if (e.kind == sim::SimEvent::Kind::kTof) {
-      if (auto out = decoder.decode(robot, e.tof); out.range) core.on_range(robot, out.range->range);
-      return;
-    }
-    if (auto pose = core.on_odometry(robot, e.odometry)) {
+    if (auto pose = stack.feed(robot, e)) {
       if (e.stamp_ns > s_to_ns(robot == "a" ? 3.0 : 10.0)) {
         worst = std::max(worst, (pose->estimate.pose_map_base.head<2>() - e.truth_map_base.head<2>()).norm());
       }
@@ -48,7 +38,7 @@ TEST(LocalizerCore, KeepsRobotsApartOnSharedTopics) {
     if (i < ea.size()) feed("a", ea[i]);
     if (i < eb.size()) feed("b", eb[i]);
   }
-  EXPECT_EQ(core.robot_count(), 2u);
+  EXPECT_EQ(stack.localizer.robot_count(), 2u);
   EXPECT_LT(worst, 0.1);
   EXPECT_EQ(used.size(), scenario.beacons.size());
 }

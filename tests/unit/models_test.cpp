@@ -21,11 +21,13 @@ TEST(DiffDriveMotion, PoseJacobianMatchesNumeric) {
         Pose2 hi = x, lo = x;
         hi[j] += kStep;
         lo[j] -= kStep;
-        Eigen::Vector3d d = predict_diff_drive(hi, vr, vl, 0.33, 0.01).pose -
-                            predict_diff_drive(lo, vr, vl, 0.33, 0.01).pose;
+        Eigen::Vector3d d =
+            predict_diff_drive(hi, vr, vl, 0.33, 0.01).pose - predict_diff_drive(lo, vr, vl, 0.33, 0.01).pose;
         d.z() = wrap_angle_rad(d.z());
         EXPECT_TRUE(p.jacobian_pose.col(j).isApprox(d / (2 * kStep), 1e-6))
-            << "column " << j << " yaw " << yaw << "\n" << p.jacobian_pose << "\n" << d.transpose() / (2 * kStep);
+            << "column " << j << " yaw " << yaw << "\n"
+            << p.jacobian_pose << "\n"
+            << d.transpose() / (2 * kStep);
       }
     }
   }
@@ -43,11 +45,12 @@ TEST(DiffDriveMotion, WheelJacobianMatchesNumericWithErratumCorrection) {
         double hi[2] = {u[0], u[1]}, lo[2] = {u[0], u[1]};
         hi[j] += kStep;
         lo[j] -= kStep;
-        Eigen::Vector3d d = predict_diff_drive(x, hi[0], hi[1], b, dt).pose -
-                            predict_diff_drive(x, lo[0], lo[1], b, dt).pose;
+        Eigen::Vector3d d =
+            predict_diff_drive(x, hi[0], hi[1], b, dt).pose - predict_diff_drive(x, lo[0], lo[1], b, dt).pose;
         d.z() = wrap_angle_rad(d.z());
-        EXPECT_TRUE(p.jacobian_wheels.col(j).isApprox(d / (2 * kStep), 1e-6))
-            << "column " << j << "\n" << p.jacobian_wheels << "\n" << d.transpose() / (2 * kStep);
+        EXPECT_TRUE(p.jacobian_wheels.col(j).isApprox(d / (2 * kStep), 1e-6)) << "column " << j << "\n"
+                                                                              << p.jacobian_wheels << "\n"
+                                                                              << d.transpose() / (2 * kStep);
       }
     }
   }
@@ -70,16 +73,16 @@ TEST(RangeModel, ValueIsTheThreeDimensionalDistance) {
   const Pose2 x(0.5, -0.25, 0.8);
   const Eigen::Vector2d rx(0.19 * std::cos(2 * M_PI / 3), 0.19 * std::sin(2 * M_PI / 3));
   const Eigen::Vector2d rx_map = transform_point(x, rx);
-  const double expected = std::sqrt(std::pow(rx_map.x() - 2.0, 2) + std::pow(rx_map.y() - 1.0, 2) +
-                                     std::pow(2.011, 2));
+  const double expected =
+      std::sqrt(std::pow(rx_map.x() - 2.0, 2) + std::pow(rx_map.y() - 1.0, 2) + std::pow(2.011, 2));
   EXPECT_NEAR(predict_range(x, rx, 0.0, beacon).range_m, expected, 1e-12);
 }
 
 TEST(RangeModel, JacobianMatchesNumeric) {
   const Eigen::Vector3d beacon(1.5, -0.3, 2.011);
   for (double yaw : {-2.5, -0.3, 0.0, 1.1, 3.0}) {
-    for (const Eigen::Vector2d& rx : {Eigen::Vector2d(0.19, 0.0), Eigen::Vector2d(-0.095, 0.1645),
-                                      Eigen::Vector2d(0.0, 0.0)}) {
+    for (const Eigen::Vector2d& rx :
+         {Eigen::Vector2d(0.19, 0.0), Eigen::Vector2d(-0.095, 0.1645), Eigen::Vector2d(0.0, 0.0)}) {
       for (double rz : {0.0, 0.3}) {
         const Pose2 x(0.2, 1.4, yaw);
         const auto p = predict_range(x, rx, rz, beacon);

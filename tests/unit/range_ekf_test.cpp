@@ -33,14 +33,13 @@ TEST(RangeEkf, TracksTheDefaultScenarioOverTenSeeds) {
     sum_rms += run.error.position_rms_m();
     sum_heading += run.error.heading_rms_deg();
     sum_nees += run.nees_in_band_fraction();
-    EXPECT_EQ(run.localizer_counts.rejected("range.gated_nis") * 100 <
-                  run.localizer_counts.accepted(),
-              true)
+    EXPECT_EQ(run.localizer_counts.rejected("range.gated_nis") * 100 < run.localizer_counts.accepted(), true)
         << "more than 1 % of good ranges gated, seed " << seed;
   }
-  std::printf("range_ekf, default scenario, 10 seeds x 60 s: mean position RMS %.4f m (worst %.4f), "
-              "mean heading RMS %.2f deg, mean NEES-in-95%%-band %.2f\n",
-              sum_rms / 10, worst_rms, sum_heading / 10, sum_nees / 10);
+  std::printf(
+      "range_ekf, default scenario, 10 seeds x 60 s: mean position RMS %.4f m (worst %.4f), "
+      "mean heading RMS %.2f deg, mean NEES-in-95%%-band %.2f\n",
+      sum_rms / 10, worst_rms, sum_heading / 10, sum_nees / 10);
   EXPECT_LT(worst_rms, 0.05);
   EXPECT_LT(sum_heading / 10, 3.0);
   EXPECT_GE(sum_nees / 10, 0.80) << "the covariance is not honest";
@@ -100,25 +99,13 @@ TEST(RangeEkf, RefusesBadInputWithATypedReason) {
 }
 
 TEST(RangeEkf, DegradesWithoutRangesAndRecoversWhenTheyReturn) {
-  sim::Scenario scenario = sim::default_scenario();
-  EstimatorConfig config;
-  config.receivers = scenario.receivers;
-  LocalizerCore core("range_ekf", config);
-  core.set_beacon_map(BeaconMap(scenario.beacons));
-  TofDecoder decoder;
-  decoder.set_beacon_map(BeaconMap(scenario.beacons));
-  sim::SimSource source(scenario, 2);
-  std::vector<sim::SimEvent> events;
-  source.advance(s_to_ns(20.0), events);
+  testing::OfflineStack stack(sim::default_scenario());
   PoseStatus at_8s = PoseStatus::kInitializing, at_20s = PoseStatus::kInitializing;
-  for (const auto& e : events) {
+  for (const auto& e : testing::simulate(sim::default_scenario(), 2, 20.0)) {
     const double t = ns_to_s(e.stamp_ns);
-    if (e.kind == sim::SimEvent::Kind::kTof) {
-      if (t > 5.0 && t < 8.0) continue;  // the beacons fall silent for 3 s
-      if (auto out = decoder.decode("r", e.tof); out.range) core.on_range("r", out.range->range);
-      continue;
-    }
-    const auto pose = core.on_odometry("r", e.odometry);
+    const bool silenced = e.kind == sim::SimEvent::Kind::kTof && t > 5.0 && t < 8.0;
+    if (silenced) continue;  // the beacons fall silent for 3 s
+    const auto pose = stack.feed("r", e);
     if (pose && std::abs(t - 7.9) < 0.005) at_8s = pose->estimate.status;
     if (pose) at_20s = pose->estimate.status;
   }

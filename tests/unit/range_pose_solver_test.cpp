@@ -1,10 +1,11 @@
 // Global pose from ranges alone: exact on noise-free ranges from any start, refuses what it
 // cannot solve.
+#include "beaconloc/core/solvers/range_pose_solver.hpp"
+
 #include <gtest/gtest.h>
 
 #include "beaconloc/core/models/range_model.hpp"
 #include "beaconloc/core/receiver_array.hpp"
-#include "beaconloc/core/solvers/range_pose_solver.hpp"
 
 namespace beaconloc {
 namespace {

@@ -40,8 +40,8 @@ TEST(SimSource, EventsComeInStampOrderAtTheScenarioRates) {
   std::size_t odometry = 0, tofs = 0;
   for (std::size_t i = 1; i < events.size(); ++i) ASSERT_LE(events[i - 1].stamp_ns, events[i].stamp_ns);
   for (const auto& e : events) (e.kind == SimEvent::Kind::kOdometry ? odometry : tofs)++;
-  EXPECT_EQ(odometry, 1000u);   // 100 Hz
-  EXPECT_EQ(tofs, 50u * 3u);    // 5 Hz slots x 3 receivers, every beacon in range
+  EXPECT_EQ(odometry, 1000u);  // 100 Hz
+  EXPECT_EQ(tofs, 50u * 3u);   // 5 Hz slots x 3 receivers, every beacon in range
 }
 
 TEST(SimSource, StaticRobotTofIsTheDistanceOverTheSpeedOfSound) {
@@ -51,9 +51,11 @@ TEST(SimSource, StaticRobotTofIsTheDistanceOverTheSpeedOfSound) {
   const double c = speed_of_sound_mps(s.temperature_c);
   for (const auto& e : run(s, 1, 2.0)) {
     if (e.kind != SimEvent::Kind::kTof) continue;
-    const Eigen::Vector2d rx = transform_point(s.trajectory.pose_at(0.0), s.receivers.receivers_base_m[e.tof.receiver_id]);
+    const Eigen::Vector2d rx =
+        transform_point(s.trajectory.pose_at(0.0), s.receivers.receivers_base_m[e.tof.receiver_id]);
     Eigen::Vector3d beacon = Eigen::Vector3d::Zero();
-    for (const auto& b : s.beacons) if (b.id == e.tof.beacon_id) beacon = b.position_map_m;
+    for (const auto& b : s.beacons)
+      if (b.id == e.tof.beacon_id) beacon = b.position_map_m;
     const double d = Eigen::Vector3d(rx.x() - beacon.x(), rx.y() - beacon.y(), -beacon.z()).norm();
     EXPECT_NEAR(e.tof.tof_s, d / c, 1e-12);
   }
@@ -75,7 +77,8 @@ TEST(SimSource, MovingRobotHearsThePulseWhereItIsAtArrival) {
     const double fire_s = ns_to_s(e.tof.fire_stamp_ns), arrival_s = fire_s + e.tof.tof_s;
     const Eigen::Vector3d beacon = s.beacons[0].position_map_m;
     auto distance_at = [&](double t) {
-      const Eigen::Vector2d rx = transform_point(s.trajectory.pose_at(t), s.receivers.receivers_base_m[e.tof.receiver_id]);
+      const Eigen::Vector2d rx =
+          transform_point(s.trajectory.pose_at(t), s.receivers.receivers_base_m[e.tof.receiver_id]);
       return Eigen::Vector3d(rx.x() - beacon.x(), rx.y() - beacon.y(), -beacon.z()).norm();
     };
     EXPECT_NEAR(e.tof.tof_s * c, distance_at(arrival_s), 1e-9);  // self-consistent flight
@@ -97,7 +100,8 @@ TEST(SimSource, NoiseFreeOdometryIntegratesToTheTruth) {
   for (const auto& e : run(s, 1, 30.0)) {
     if (e.kind != SimEvent::Kind::kOdometry) continue;
     pose = predict_diff_drive(pose, e.odometry.wheel_velocity_right_mps, e.odometry.wheel_velocity_left_mps,
-                              e.odometry.wheel_base_m, ns_to_s(e.stamp_ns - last)).pose;
+                              e.odometry.wheel_base_m, ns_to_s(e.stamp_ns - last))
+               .pose;
     last = e.stamp_ns;
     truth = e.truth_map_base;
   }

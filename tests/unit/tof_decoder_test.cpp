@@ -1,12 +1,13 @@
 // The decoder core: range from TOF with the paper's speed of sound, and a typed, counted
 // rejection for each kind of bad input.
+#include "tof_decoder.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
 #include "beaconloc/core/speed_of_sound.hpp"
-#include "tof_decoder.hpp"
 
 namespace beaconloc {
 namespace {
@@ -77,7 +78,7 @@ TEST(TofDecoder, CountsEveryRejectionByReason) {
   s.beacon_id = 99;
   expect_rejected(s, TofRejection::kUnknownBeacon);
 
-  ASSERT_TRUE(d.decode("r1", good(++seq, 5'000'000'000)).range);  // newest firing: 5 s
+  ASSERT_TRUE(d.decode("r1", good(++seq, 5'000'000'000)).range);      // newest firing: 5 s
   expect_rejected(good(++seq, 4'000'000'000), TofRejection::kStale);  // 1 s older than newest
   const auto dup = good(++seq, 4'900'000'000);
   ASSERT_TRUE(d.decode("r1", dup).range);  // 100 ms out of order: still useful, accepted

@@ -22,12 +22,9 @@ Scenario default_scenario() {
   s.wheel_base_m = 0.33;
   const double v = 0.34, turn_radius = 0.6, straight = 2.0;
   const double w = v / turn_radius;
-  s.trajectory = Trajectory({0.5, 0.0, 0.0},
-                            {{straight / v, v, 0.0},
-                             {M_PI / w, v, w},
-                             {straight / v, v, 0.0},
-                             {M_PI / w, v, w}},
-                            /*loop=*/true);
+  s.trajectory = Trajectory(
+      {0.5, 0.0, 0.0}, {{straight / v, v, 0.0}, {M_PI / w, v, w}, {straight / v, v, 0.0}, {M_PI / w, v, w}},
+      /*loop=*/true);
   return s;
 }
 

@@ -18,11 +18,11 @@ struct Scenario {
   std::vector<std::uint32_t> firing_order;  // beacon ids, one per slot, cycled
   ReceiverArray receivers;
   double wheel_base_m = 0.33;
-  double odometry_k_v_m = 4e-4;      // seed 000: sigma_v^2 = k_v |v| / dT per wheel
-  double range_sigma_m = 0.01;       // seed 000: sigma_dd
-  double temperature_c = 22.0;       // air temperature, reported by the beacons
-  double max_range_m = 5.0;          // a receiver hears a beacon up to this slant range
-  StampNs slot_period_ns = 200 * kNsPerMillisecond;     // 5 Hz firing slots
+  double odometry_k_v_m = 4e-4;                      // seed 000: sigma_v^2 = k_v |v| / dT per wheel
+  double range_sigma_m = 0.01;                       // seed 000: sigma_dd
+  double temperature_c = 22.0;                       // air temperature, reported by the beacons
+  double max_range_m = 5.0;                          // a receiver hears a beacon up to this slant range
+  StampNs slot_period_ns = 200 * kNsPerMillisecond;  // 5 Hz firing slots
   StampNs first_slot_ns = 50 * kNsPerMillisecond;
   StampNs odometry_period_ns = 10 * kNsPerMillisecond;  // 100 Hz
   Trajectory trajectory;

@@ -7,14 +7,13 @@
 namespace beaconloc::sim {
 
 double pulse_arrival_s(const Trajectory& trajectory, const Eigen::Vector2d& receiver_base_m,
-                       double receiver_z_m, const Eigen::Vector3d& beacon_map_m, double fire_s,
-                       double c) {
+                       double receiver_z_m, const Eigen::Vector3d& beacon_map_m, double fire_s, double c) {
   double arrival_s = fire_s;
   for (int i = 0; i < 6; ++i) {
     const Eigen::Vector2d rx = transform_point(trajectory.pose_at(arrival_s), receiver_base_m);
-    const double d = Eigen::Vector3d(rx.x() - beacon_map_m.x(), rx.y() - beacon_map_m.y(),
-                                     receiver_z_m - beacon_map_m.z())
-                         .norm();
+    const double d =
+        Eigen::Vector3d(rx.x() - beacon_map_m.x(), rx.y() - beacon_map_m.y(), receiver_z_m - beacon_map_m.z())
+            .norm();
     arrival_s = fire_s + d / c;
   }
   return arrival_s;
@@ -65,8 +64,7 @@ SimEvent SimSource::odometry_at(StampNs stamp_ns) {
   const double true_right = v + w * half_track, true_left = v - w * half_track;
   // Seed 000: sigma_v^2 = k_v |v| / dT for each wheel.
   auto noisy = [&](double wheel_mps) {
-    return wheel_mps +
-           std::sqrt(scenario_.odometry_k_v_m * std::abs(wheel_mps) / dt_s) * unit_normal_(rng_);
+    return wheel_mps + std::sqrt(scenario_.odometry_k_v_m * std::abs(wheel_mps) / dt_s) * unit_normal_(rng_);
   };
   SimEvent e;
   e.kind = SimEvent::Kind::kOdometry;

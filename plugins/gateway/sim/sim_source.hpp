@@ -16,10 +16,10 @@ namespace beaconloc::sim {
 struct SimEvent {
   enum class Kind { kOdometry, kTof };
   Kind kind = Kind::kOdometry;
-  StampNs stamp_ns = 0;            // sim time: odometry stamp, or arrival of the pulse
-  OdometrySample odometry;         // kOdometry
+  StampNs stamp_ns = 0;                  // sim time: odometry stamp, or arrival of the pulse
+  OdometrySample odometry;               // kOdometry
   Pose2 truth_map_base = Pose2::Zero();  // kOdometry: true pose at stamp_ns
-  RawTofSample tof;                // kTof
+  RawTofSample tof;                      // kTof
 };
 
 class SimSource {

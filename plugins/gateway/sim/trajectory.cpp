@@ -11,8 +11,8 @@ Pose2 integrate_arc(const Pose2& from, double v, double w, double t) {
   }
   const double r = v / w;
   const double yaw1 = yaw + w * t;
-  return {from.x() + r * (std::sin(yaw1) - std::sin(yaw)),
-          from.y() - r * (std::cos(yaw1) - std::cos(yaw)), wrap_angle_rad(yaw1)};
+  return {from.x() + r * (std::sin(yaw1) - std::sin(yaw)), from.y() - r * (std::cos(yaw1) - std::cos(yaw)),
+          wrap_angle_rad(yaw1)};
 }
 
 Trajectory::Trajectory(const Pose2& start, std::vector<VelocitySegment> segments, bool loop)

@@ -29,7 +29,7 @@ class Trajectory {
 
   Pose2 start_ = Pose2::Zero();
   std::vector<VelocitySegment> segments_;
-  Pose2 lap_end_ = Pose2::Zero();      // pose after one lap, relative to start_
+  Pose2 lap_end_ = Pose2::Zero();  // pose after one lap, relative to start_
   double period_s_ = 0.0;
   double lap_distance_m_ = 0.0;
   double lap_heading_rad_ = 0.0;

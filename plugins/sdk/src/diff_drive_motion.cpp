@@ -5,8 +5,7 @@
 namespace beaconloc {
 
 DiffDrivePrediction predict_diff_drive(const Pose2& pose, double wheel_velocity_right_mps,
-                                       double wheel_velocity_left_mps, double wheel_base_m,
-                                       double dt_s) {
+                                       double wheel_velocity_left_mps, double wheel_base_m, double dt_s) {
   const double delta_d = dt_s * (wheel_velocity_right_mps + wheel_velocity_left_mps) / 2.0;
   const double delta_phi = dt_s * (wheel_velocity_right_mps - wheel_velocity_left_mps) / wheel_base_m;
   const double heading = pose.z() + delta_phi / 2.0;
@@ -23,7 +22,7 @@ DiffDrivePrediction predict_diff_drive(const Pose2& pose, double wheel_velocity_
   d_pose_d_increment << c, -delta_d / 2.0 * s,     //
       s, delta_d / 2.0 * c,                        //
       0.0, 1.0;
-  Eigen::Matrix2d d_increment_d_wheels;  // d [Delta D, Delta phi] / d [v_R, v_L]
+  Eigen::Matrix2d d_increment_d_wheels;            // d [Delta D, Delta phi] / d [v_R, v_L]
   d_increment_d_wheels << dt_s / 2.0, dt_s / 2.0,  //
       dt_s / wheel_base_m, -dt_s / wheel_base_m;
   out.jacobian_wheels = d_pose_d_increment * d_increment_d_wheels;

@@ -6,10 +6,14 @@ namespace beaconloc {
 
 const char* to_string(PoseStatus s) {
   switch (s) {
-    case PoseStatus::kInitializing: return "initializing";
-    case PoseStatus::kOk: return "ok";
-    case PoseStatus::kDegraded: return "degraded";
-    case PoseStatus::kLost: return "lost";
+    case PoseStatus::kInitializing:
+      return "initializing";
+    case PoseStatus::kOk:
+      return "ok";
+    case PoseStatus::kDegraded:
+      return "degraded";
+    case PoseStatus::kLost:
+      return "lost";
   }
   return "unknown";
 }

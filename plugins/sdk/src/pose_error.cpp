@@ -7,7 +7,7 @@ namespace beaconloc {
 
 void PoseErrorAccumulator::add(const Pose2& truth, const Pose2& estimate) {
   const double e_p = (truth.head<2>() - estimate.head<2>()).norm();  // eq. 33
-  const double e_phi = wrap_angle_rad(truth.z() - estimate.z());       // eq. 34
+  const double e_phi = wrap_angle_rad(truth.z() - estimate.z());     // eq. 34
   ++n_;
   sum_sq_position_ += e_p * e_p;
   sum_position_ += e_p;

@@ -4,12 +4,11 @@
 
 namespace beaconloc {
 
-RangePrediction predict_range(const Pose2& pose, const Eigen::Vector2d& receiver_base_m,
-                              double receiver_z_m, const Eigen::Vector3d& beacon_map_m) {
+RangePrediction predict_range(const Pose2& pose, const Eigen::Vector2d& receiver_base_m, double receiver_z_m,
+                              const Eigen::Vector3d& beacon_map_m) {
   const double c = std::cos(pose.z()), s = std::sin(pose.z());
   const Eigen::Vector2d receiver_map = transform_point(pose, receiver_base_m);
-  const Eigen::Vector3d delta(receiver_map.x() - beacon_map_m.x(),
-                              receiver_map.y() - beacon_map_m.y(),
+  const Eigen::Vector3d delta(receiver_map.x() - beacon_map_m.x(), receiver_map.y() - beacon_map_m.y(),
                               receiver_z_m - beacon_map_m.z());
   RangePrediction out;
   out.range_m = delta.norm();

@@ -34,15 +34,13 @@ Refined refine(const std::vector<RangeObservation>& obs, Pose2 pose, int max_ite
     Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
     Eigen::Vector3d grad = Eigen::Vector3d::Zero();
     for (const auto& o : obs) {
-      const RangePrediction p =
-          predict_range(pose, o.receiver_solve_frame_m, o.receiver_z_m, o.beacon_map_m);
+      const RangePrediction p = predict_range(pose, o.receiver_solve_frame_m, o.receiver_z_m, o.beacon_map_m);
       const double w = 1.0 / o.variance_m2;
       info += w * p.jacobian_pose.transpose() * p.jacobian_pose;
       grad += w * p.jacobian_pose.transpose() * (o.range_m - p.range_m);
     }
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(info);
-    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
-        (ldlt.vectorD().array() <= 1e-12).any()) {
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || (ldlt.vectorD().array() <= 1e-12).any()) {
       return out;  // unobservable from these ranges (e.g. all beacons collinear with the robot)
     }
     Eigen::Vector3d step = ldlt.solve(grad);
@@ -69,8 +67,7 @@ Refined refine(const std::vector<RangeObservation>& obs, Pose2 pose, int max_ite
   // Information at the final pose.
   Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
   for (const auto& o : obs) {
-    const RangePrediction p =
-        predict_range(pose, o.receiver_solve_frame_m, o.receiver_z_m, o.beacon_map_m);
+    const RangePrediction p = predict_range(pose, o.receiver_solve_frame_m, o.receiver_z_m, o.beacon_map_m);
     info += p.jacobian_pose.transpose() * p.jacobian_pose / o.variance_m2;
   }
   out.converged = true;

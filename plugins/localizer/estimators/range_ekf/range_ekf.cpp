@@ -26,9 +26,8 @@ RangeEkf::RangeEkf(const EstimatorConfig& config)
     : receivers_(config.receivers), params_(RangeEkfParameters::from(config)) {}
 
 InputResult RangeEkf::predict(const OdometrySample& o) {
-  const bool finite = std::isfinite(o.wheel_velocity_right_mps) &&
-                      std::isfinite(o.wheel_velocity_left_mps) && std::isfinite(o.wheel_base_m) &&
-                      o.wheel_velocity_covariance.allFinite();
+  const bool finite = std::isfinite(o.wheel_velocity_right_mps) && std::isfinite(o.wheel_velocity_left_mps) &&
+                      std::isfinite(o.wheel_base_m) && o.wheel_velocity_covariance.allFinite();
   if (!finite) return InputResult::rejected("non_finite_odometry");
   if (!(o.wheel_base_m > 0.0)) return InputResult::rejected("invalid_wheel_base");
   if ((o.wheel_velocity_covariance.diagonal().array() < 0.0).any()) {
@@ -53,9 +52,8 @@ InputResult RangeEkf::predict(const OdometrySample& o) {
                                   o.wheel_base_m, dt_s)
                    .pose;
   if (initialized_) {
-    const DiffDrivePrediction p =
-        predict_diff_drive(ekf_.state(), o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
-                           o.wheel_base_m, dt_s);
+    const DiffDrivePrediction p = predict_diff_drive(ekf_.state(), o.wheel_velocity_right_mps,
+                                                     o.wheel_velocity_left_mps, o.wheel_base_m, dt_s);
     const Eigen::Matrix2d u = o.wheel_velocity_covariance +
                               params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity();
     // Eq. 16: P = J_f,x P J_f,x^T + J_f,u U J_f,u^T.
@@ -73,15 +71,13 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
   if (map_.empty()) return InputResult::rejected("no_beacon_map");
   if (!map_.find(r.beacon_id)) return InputResult::rejected("unknown_beacon");
   if (r.receiver_id >= receivers_.size()) return InputResult::rejected("unknown_receiver");
-  if (last_odometry_stamp_ns_ &&
-      r.stamp_ns < *last_odometry_stamp_ns_ - s_to_ns(params_.max_range_age_s)) {
+  if (last_odometry_stamp_ns_ && r.stamp_ns < *last_odometry_stamp_ns_ - s_to_ns(params_.max_range_age_s)) {
     return InputResult::rejected("stale_range");
   }
 
   // Every good range joins the window a global fix is computed from.
   window_.push_back({r, odom_pose_});
-  while (!window_.empty() &&
-         window_.front().range.stamp_ns < r.stamp_ns - s_to_ns(params_.init_window_s)) {
+  while (!window_.empty() && window_.front().range.stamp_ns < r.stamp_ns - s_to_ns(params_.init_window_s)) {
     window_.pop_front();
   }
   if (!initialized_) {
@@ -132,8 +128,7 @@ void RangeEkf::try_initialize() {
     const Pose2 then_in_now = between(odom_pose_, b.odom_pose_at_range);
     const double travelled_m = then_in_now.head<2>().norm();
     RangeObservation o;
-    o.receiver_solve_frame_m =
-        transform_point(then_in_now, receivers_.receivers_base_m[b.range.receiver_id]);
+    o.receiver_solve_frame_m = transform_point(then_in_now, receivers_.receivers_base_m[b.range.receiver_id]);
     o.receiver_z_m = receivers_.receiver_height_m;
     o.beacon_map_m = map_.find(b.range.beacon_id)->position_map_m;
     o.range_m = b.range.range_m;
@@ -173,9 +168,11 @@ PoseStatus RangeEkf::status() const {
 }
 
 namespace {
-BEACONLOC_REGISTER_ESTIMATOR(
-    "range_ekf", "EKF on [x, y, yaw]: odometry prediction, one update per range, NIS gating",
-    [](const EstimatorConfig& config) { return std::make_unique<RangeEkf>(config); });
+BEACONLOC_REGISTER_ESTIMATOR("range_ekf",
+                             "EKF on [x, y, yaw]: odometry prediction, one update per range, NIS gating",
+                             [](const EstimatorConfig& config) {
+                               return std::make_unique<RangeEkf>(config);
+                             });
 }  // namespace
 
 }  // namespace beaconloc

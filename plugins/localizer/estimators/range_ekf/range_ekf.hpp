@@ -13,12 +13,12 @@
 namespace beaconloc {
 
 struct RangeEkfParameters {
-  double nis_gate = 10.83;            // chi-square, 1 dof, 99.9 %
-  double init_window_s = 3.0;         // ranges kept for a global fix
+  double nis_gate = 10.83;     // chi-square, 1 dof, 99.9 %
+  double init_window_s = 3.0;  // ranges kept for a global fix
   int init_min_beacons = 3;
   double init_max_position_sigma_m = 0.3;
   double init_max_yaw_sigma_rad = 0.35;
-  double max_odometry_gap_s = 0.2;    // a longer gap is not integrated (reason odometry_gap)
+  double max_odometry_gap_s = 0.2;  // a longer gap is not integrated (reason odometry_gap)
   double wheel_velocity_variance_floor_m2ps2 = 1e-6;
   int reinitialize_after_gated = 15;  // 5 slots x 3 receivers refused in a row: lost
   double max_range_age_s = 0.6;       // ranges older than the newest odometry by more: stale

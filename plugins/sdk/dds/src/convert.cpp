@@ -52,8 +52,7 @@ msg::Odometry to_msg(const std::string& robot_id, const OdometrySample& s, std::
 RangeMeasurement from_msg(const msg::BeaconRange& m) {
   RangeMeasurement r;
   r.stamp_ns = m.stamp_ns();
-  r.beacon_id = m.association() == msg::RANGE_ASSOCIATION_UNASSOCIATED ? kBeaconUnidentified
-                                                                        : m.beacon_id();
+  r.beacon_id = m.association() == msg::RANGE_ASSOCIATION_UNASSOCIATED ? kBeaconUnidentified : m.beacon_id();
   r.receiver_id = m.receiver_id();
   r.range_m = m.range_m();
   r.variance_m2 = m.variance_m2();
@@ -83,22 +82,56 @@ msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id) {
   return m;
 }
 
+msg::PoseEstimate to_msg(const std::string& robot_id, const PoseEstimate& e, const std::string& estimator,
+                         const std::vector<std::uint32_t>& beacons_used) {
+  msg::PoseEstimate m;
+  m.robot_id(robot_id);
+  m.stamp_ns(e.stamp_ns);
+  m.x_m(e.pose_map_base.x());
+  m.y_m(e.pose_map_base.y());
+  m.yaw_rad(e.pose_map_base.z());
+  std::array<double, 9> covariance{};
+  Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(covariance.data()) = e.covariance;
+  m.covariance(covariance);
+  m.estimator(estimator);
+  m.status(to_msg(e.status));
+  m.beacons_used(beacons_used);
+  return m;
+}
+
+PoseEstimate from_msg(const msg::PoseEstimate& m) {
+  PoseEstimate e;
+  e.stamp_ns = m.stamp_ns();
+  e.pose_map_base = {m.x_m(), m.y_m(), m.yaw_rad()};
+  e.covariance = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m.covariance().data());
+  e.status = from_msg(m.status());
+  return e;
+}
+
 msg::PoseStatus to_msg(PoseStatus s) {
   switch (s) {
-    case PoseStatus::kInitializing: return msg::POSE_STATUS_INITIALIZING;
-    case PoseStatus::kOk: return msg::POSE_STATUS_OK;
-    case PoseStatus::kDegraded: return msg::POSE_STATUS_DEGRADED;
-    case PoseStatus::kLost: return msg::POSE_STATUS_LOST;
+    case PoseStatus::kInitializing:
+      return msg::POSE_STATUS_INITIALIZING;
+    case PoseStatus::kOk:
+      return msg::POSE_STATUS_OK;
+    case PoseStatus::kDegraded:
+      return msg::POSE_STATUS_DEGRADED;
+    case PoseStatus::kLost:
+      return msg::POSE_STATUS_LOST;
   }
   return msg::POSE_STATUS_LOST;
 }
 
 PoseStatus from_msg(msg::PoseStatus s) {
   switch (s) {
-    case msg::POSE_STATUS_INITIALIZING: return PoseStatus::kInitializing;
-    case msg::POSE_STATUS_OK: return PoseStatus::kOk;
-    case msg::POSE_STATUS_DEGRADED: return PoseStatus::kDegraded;
-    case msg::POSE_STATUS_LOST: return PoseStatus::kLost;
+    case msg::POSE_STATUS_INITIALIZING:
+      return PoseStatus::kInitializing;
+    case msg::POSE_STATUS_OK:
+      return PoseStatus::kOk;
+    case msg::POSE_STATUS_DEGRADED:
+      return PoseStatus::kDegraded;
+    case msg::POSE_STATUS_LOST:
+      return PoseStatus::kLost;
   }
   return PoseStatus::kLost;
 }

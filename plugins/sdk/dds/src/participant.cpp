@@ -80,15 +80,13 @@ Topic* Participant::topic(const std::string& name, TopicDataType* type) {
   return t;
 }
 
-DataWriter* Participant::make_writer(Topic* topic, const std::string& profile,
-                                     DataWriterListener* listener) {
+DataWriter* Participant::make_writer(Topic* topic, const std::string& profile, DataWriterListener* listener) {
   DataWriter* w = publisher_->create_datawriter_with_profile(topic, profile, listener);
   if (!w) throw DdsError("cannot create writer on " + topic->get_name() + " with profile " + profile);
   return w;
 }
 
-DataReader* Participant::make_reader(Topic* topic, const std::string& profile,
-                                     DataReaderListener* listener) {
+DataReader* Participant::make_reader(Topic* topic, const std::string& profile, DataReaderListener* listener) {
   DataReader* r = subscriber_->create_datareader_with_profile(topic, profile, listener);
   if (!r) throw DdsError("cannot create reader on " + topic->get_name() + " with profile " + profile);
   return r;

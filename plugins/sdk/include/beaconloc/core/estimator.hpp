@@ -58,7 +58,7 @@ class Estimator {
 
 // Status policy shared by estimators: how long without a fused range the pose stays OK.
 struct StalenessPolicy {
-  StampNs degraded_after_ns = 1'000'000'000;   // 5 missed beacon slots
+  StampNs degraded_after_ns = 1'000'000'000;  // 5 missed beacon slots
   StampNs lost_after_ns = 10'000'000'000;
   PoseStatus classify(StampNs now_ns, StampNs last_correction_ns) const {
     const StampNs age = now_ns - last_correction_ns;

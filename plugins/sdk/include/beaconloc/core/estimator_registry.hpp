@@ -42,6 +42,6 @@ class EstimatorRegistry {
 #define BEACONLOC_CONCAT_INNER(a, b) a##b
 #define BEACONLOC_CONCAT(a, b) BEACONLOC_CONCAT_INNER(a, b)
 // Use once per estimator at namespace scope in its .cpp.
-#define BEACONLOC_REGISTER_ESTIMATOR(name, description, factory)                 \
-  static const bool BEACONLOC_CONCAT(beaconloc_registered_, __LINE__) =          \
+#define BEACONLOC_REGISTER_ESTIMATOR(name, description, factory)        \
+  static const bool BEACONLOC_CONCAT(beaconloc_registered_, __LINE__) = \
       ::beaconloc::EstimatorRegistry::instance().add(name, description, factory)

@@ -23,6 +23,10 @@ RangeMeasurement from_msg(const msg::BeaconRange& m);
 BeaconMap from_msg(const msg::BeaconMap& m);
 msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id);
 
+msg::PoseEstimate to_msg(const std::string& robot_id, const PoseEstimate& estimate,
+                         const std::string& estimator, const std::vector<std::uint32_t>& beacons_used);
+PoseEstimate from_msg(const msg::PoseEstimate& m);
+
 msg::PoseStatus to_msg(PoseStatus s);
 PoseStatus from_msg(msg::PoseStatus s);
 

@@ -12,12 +12,10 @@ inline constexpr TopicSpec kRawTofTopic{"beaconloc/raw_tof", "raw_tof.writer", "
 inline constexpr TopicSpec kBeaconRangeTopic{"beaconloc/beacon_range", "beacon_range.writer",
                                              "beacon_range.reader"};
 inline constexpr TopicSpec kOdometryTopic{"beaconloc/odometry", "odometry.writer", "odometry.reader"};
-inline constexpr TopicSpec kLaserScanTopic{"beaconloc/laser_scan", "laser_scan.writer",
-                                           "laser_scan.reader"};
+inline constexpr TopicSpec kLaserScanTopic{"beaconloc/laser_scan", "laser_scan.writer", "laser_scan.reader"};
 inline constexpr TopicSpec kPoseEstimateTopic{"beaconloc/pose_estimate", "pose_estimate.writer",
                                               "pose_estimate.reader"};
-inline constexpr TopicSpec kBeaconMapTopic{"beaconloc/beacon_map", "beacon_map.writer",
-                                           "beacon_map.reader"};
+inline constexpr TopicSpec kBeaconMapTopic{"beaconloc/beacon_map", "beacon_map.writer", "beacon_map.reader"};
 inline constexpr TopicSpec kDiagnosticsTopic{"beaconloc/diagnostics", "diagnostics.writer",
                                              "diagnostics.reader"};
 

@@ -9,13 +9,13 @@ namespace beaconloc {
 
 enum class UpdateOutcome {
   kApplied,
-  kGated,                  // NIS above the gate: the measurement is an outlier for this state
-  kSingularInnovation,     // S not positive definite: nothing applied
+  kGated,               // NIS above the gate: the measurement is an outlier for this state
+  kSingularInnovation,  // S not positive definite: nothing applied
 };
 
 struct UpdateResult {
   UpdateOutcome outcome = UpdateOutcome::kApplied;
-  double nis = 0.0;        // normalized innovation squared nu^T S^-1 nu
+  double nis = 0.0;  // normalized innovation squared nu^T S^-1 nu
 };
 
 template <int N>
@@ -42,14 +42,12 @@ class Ekf {
   // innovation = z - h(x) (angle components wrapped by the caller), Jacobian H, noise R.
   // Gain from an LDLT solve of S (checked), Joseph-form covariance update.
   template <int M>
-  UpdateResult update(const Eigen::Matrix<double, M, 1>& innovation,
-                      const Eigen::Matrix<double, M, N>& h,
+  UpdateResult update(const Eigen::Matrix<double, M, 1>& innovation, const Eigen::Matrix<double, M, N>& h,
                       const Eigen::Matrix<double, M, M>& r, double nis_gate) {
     UpdateResult result;
     const Eigen::Matrix<double, M, M> s = h * p_ * h.transpose() + r;
     const Eigen::LDLT<Eigen::Matrix<double, M, M>> ldlt(s);
-    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
-        (ldlt.vectorD().array() <= 0.0).any()) {
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || (ldlt.vectorD().array() <= 0.0).any()) {
       result.outcome = UpdateOutcome::kSingularInnovation;
       return result;
     }

@@ -14,7 +14,7 @@ struct RangePrediction {
 };
 
 // receiver_base_m: the receiver in the frame of `pose` (seed 000 eq. 1), at height receiver_z_m.
-RangePrediction predict_range(const Pose2& pose, const Eigen::Vector2d& receiver_base_m,
-                              double receiver_z_m, const Eigen::Vector3d& beacon_map_m);
+RangePrediction predict_range(const Pose2& pose, const Eigen::Vector2d& receiver_base_m, double receiver_z_m,
+                              const Eigen::Vector3d& beacon_map_m);
 
 }  // namespace beaconloc

@@ -18,7 +18,7 @@ struct RangeObservation {
 };
 
 struct RangePoseSolverOptions {
-  int yaw_starts = 12;            // starting headings, evenly spread
+  int yaw_starts = 12;               // starting headings, evenly spread
   int position_starts_per_axis = 3;  // grid over the beacons' bounding box
   int max_iterations = 30;
   double max_residual_rms_sigma = 3.0;  // accept when the weighted residual RMS is below this
