@@ -8,5 +8,5 @@ $SUDO apt-get update
 $SUDO apt-get install -y --no-install-recommends \
   ca-certificates cmake g++ ninja-build make \
   libfastrtps-dev libfastcdr-dev fastddsgen \
-  libeigen3-dev libcli11-dev \
+  libeigen3-dev libcli11-dev libyaml-cpp-dev \
   libgtest-dev libgmock-dev

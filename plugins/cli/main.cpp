@@ -1,21 +1,19 @@
 // beaconloc: one executable, one subcommand per participant (gateway, decoder, localizer), the
-// whole pipeline in one process (demo), and a monitor of the poses.
+// whole pipeline on a source (demo, run), scoring of recorded tracks (eval), and a monitor.
 #include <CLI/CLI.hpp>
+
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
-#include <mutex>
 #include <thread>
 
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/dds/stop_signal.hpp"
 #include "decoder_participant.hpp"
 #include "diagnostics_recorder.hpp"
-#include "gateway_participant.hpp"
 #include "localizer_participant.hpp"
+#include "pipeline.hpp"
 #include "pose_recorder.hpp"
-#include "sim/scenario.hpp"
 
 namespace beaconloc::cli {
 namespace {
@@ -23,24 +21,21 @@ namespace {
 using namespace std::chrono_literals;
 
 // Validators whose messages name the rule, not the limits of a double.
-const CLI::Validator kPositive(
-    [](std::string& v) {
-      try {
-        return std::stod(v) > 0.0 ? std::string() : "must be > 0, got " + v;
-      } catch (const std::exception&) {
-        return "not a number: " + v;
-      }
-    },
-    "POSITIVE");
-const CLI::Validator kNonNegative(
-    [](std::string& v) {
-      try {
-        return std::stod(v) >= 0.0 ? std::string() : "must be >= 0, got " + v;
-      } catch (const std::exception&) {
-        return "not a number: " + v;
-      }
-    },
-    "NON-NEGATIVE");
+CLI::Validator bound(const char* name, bool strict) {
+  return CLI::Validator(
+      [strict](std::string& v) {
+        try {
+          const double x = std::stod(v);
+          if (strict ? x > 0.0 : x >= 0.0) return std::string();
+          return std::string(strict ? "must be > 0, got " : "must be >= 0, got ") + v;
+        } catch (const std::exception&) {
+          return "not a number: " + v;
+        }
+      },
+      name);
+}
+const CLI::Validator kPositive = bound("POSITIVE", true);
+const CLI::Validator kNonNegative = bound("NON-NEGATIVE", false);
 
 void add_dds_options(CLI::App* app, dds::DdsOptions& o) {
   app->add_option("--domain", o.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
@@ -50,77 +45,56 @@ void add_dds_options(CLI::App* app, dds::DdsOptions& o) {
       ->check(CLI::ExistingFile);
 }
 
-void add_gateway_options(CLI::App* app, GatewayOptions& o) {
-  app->add_option("--robot", o.robot_id, "robot id the samples carry");
-  app->add_option("--duration-s", o.duration_s, "simulated seconds to run (0: until stopped)")
+void add_source_options(CLI::App* app, SourceChoice& s) {
+  auto* scenario = app->add_option("--scenario", s.scenario_file, "scenario YAML (default: the built-in scenario)")
+                       ->check(CLI::ExistingFile);
+  auto* replay = app->add_option("--replay", s.replay_dir, "replay a recording in the common CSV layout")
+                     ->check(CLI::ExistingDirectory);
+  scenario->excludes(replay);
+  app->add_option("--replay-wheel-base-m", s.replay.wheel_base_m,
+                  "wheel base used to express a recording's (v, omega) as wheel velocities")
+      ->check(kPositive);
+  app->add_option("--replay-odometry-k-v", s.replay.odometry_k_v_m,
+                  "odometry noise reported with replayed samples: sigma_v^2 = k_v |v| / dT per wheel")
       ->check(kNonNegative);
-  app->add_option("--speed", o.speed, "simulated seconds per wall-clock second")->check(kPositive);
-  app->add_option("--seed", o.seed, "random seed of the simulated noise");
-  app->add_option("--truth-out", o.truth_csv, "write ground truth CSV here");
 }
 
-struct LocalizerCliOptions {
-  std::string estimator = "range_ekf";
-  std::string robot;  // empty: every robot
-  double receiver_radius_m = 0.19;
-  int receiver_count = 3;
-  std::vector<std::string> parameters;
-
-  EstimatorConfig config() const {
-    EstimatorConfig c;
-    c.receivers = ReceiverArray::on_circle(receiver_radius_m, receiver_count);
-    for (const auto& p : parameters) {
-      const auto eq = p.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        throw std::invalid_argument("--param '" + p + "' is not NAME=VALUE");
-      }
-      try {
-        std::size_t used = 0;
-        const std::string value = p.substr(eq + 1);
-        c.parameters[p.substr(0, eq)] = std::stod(value, &used);
-        if (used != value.size()) throw std::invalid_argument(value);
-      } catch (const std::exception&) {
-        throw std::invalid_argument("--param '" + p + "': value is not a number");
-      }
-    }
-    return c;
-  }
-};
-
-// with_robot_filter: false where --robot already names the simulated robot (demo).
-void add_localizer_options(CLI::App* app, LocalizerCliOptions& o, bool with_robot_filter) {
-  app->add_option("--estimator", o.estimator, "estimator plugin (see --list-estimators)");
-  if (with_robot_filter) {
-    app->add_option("--robot", o.robot, "serve only this robot id (default: every robot)");
-  }
-  app->add_option("--receiver-radius-m", o.receiver_radius_m, "receivers on a circle of this radius")
-      ->check(kPositive);
-  app->add_option("--receiver-count", o.receiver_count, "number of receivers on the circle")
-      ->check(CLI::Range(1, 16));
-  app->add_option("--param", o.parameters, "estimator parameter NAME=VALUE (repeatable)");
+void add_gateway_options(CLI::App* app, GatewayOptions& o, std::optional<std::uint64_t>& seed) {
+  app->add_option("--robot", o.robot_id, "robot id the samples carry");
+  app->add_option("--duration-s", o.duration_s,
+                  "seconds of data to run (0: a recording to its end, a simulation until stopped)")
+      ->check(kNonNegative);
+  app->add_option("--speed", o.speed, "data seconds per wall-clock second")->check(kPositive);
+  app->add_option("--seed", seed, "random seed of the simulated noise (default: the scenario's)");
+  app->add_option("--truth-out", o.truth_csv, "write ground truth CSV here");
 }
 
 void add_decoder_options(CLI::App* app, TofDecoderConfig& o, double& max_age_ms) {
   app->add_option("--min-range-m", o.min_range_m, "shortest plausible range")->check(kNonNegative);
   app->add_option("--max-range-m", o.max_range_m, "longest plausible range")->check(kPositive);
   app->add_option("--range-sigma-m", o.range_sigma_m, "standard deviation of a range")->check(kPositive);
-  app->add_option("--max-age-ms", max_age_ms, "a TOF fired this long before the newest is stale")
+  app->add_option("--range-scale", o.range_scale, "ranging calibration: range = c * tof / scale")->check(kPositive);
+  app->add_option("--max-age-ms", max_age_ms, "a TOF fired this long before the newest is stale")->check(kPositive);
+}
+
+// with_robot_filter / with_circle: false where --robot names the simulated robot and the source
+// gives the receivers (demo, run).
+void add_localizer_options(CLI::App* app, LocalizerSettings& o, bool standalone) {
+  app->add_option("--estimator", o.estimator, "estimator plugin (see beaconloc localizer --list-estimators)");
+  app->add_option("--receivers", o.receivers, "receivers in the robot frame, x:y[,x:y...] (m)");
+  app->add_option("--param", o.parameters, "estimator parameter NAME=VALUE (repeatable)");
+  if (!standalone) return;
+  app->add_option("--robot", o.robot, "serve only this robot id (default: every robot)");
+  app->add_option("--receiver-radius-m", o.receiver_radius_m, "without --receivers: receivers on a circle of this radius")
       ->check(kPositive);
+  app->add_option("--receiver-count", o.receiver_count, "without --receivers: number of receivers on the circle")
+      ->check(CLI::Range(1, 16));
+  app->add_option("--receiver-height-m", o.receiver_height_m, "receivers' height above the floor");
 }
 
 void run_until_stopped() {
   while (!dds::wait_for_stop(1s)) {
   }
-}
-
-void print_summary(const PoseRunSummary& s, std::ostream& out) {
-  char line[256];
-  std::snprintf(line, sizeof line,
-                "poses: %zu at %.1f Hz; against ground truth (%zu poses): position RMS %.3f m, "
-                "mean %.3f m, max %.3f m; heading RMS %.2f deg\n",
-                s.poses, s.pose_rate_hz, s.error.samples(), s.error.position_rms_m(),
-                s.error.position_mean_m(), s.error.position_max_m(), s.error.heading_rms_deg());
-  out << line;
 }
 
 }  // namespace
@@ -131,61 +105,73 @@ int run(int argc, char** argv) {
   app.set_version_flag("--version", "beaconloc 0.1.0");
 
   dds::DdsOptions dds_options;
+  SourceChoice source_choice;
   GatewayOptions gateway_options;
+  std::optional<std::uint64_t> seed;
   TofDecoderConfig decoder_config;
   double max_age_ms = 600.0;
-  LocalizerCliOptions localizer_options;
+  LocalizerSettings localizer_settings;
   bool list_estimators = false;
-  std::string demo_out;
+  std::string out_dir;
+  bool processes = false;
   double monitor_duration_s = 0.0;
-  std::string monitor_truth, monitor_out;
+  std::string truth_file, estimate_file, beacons_file;
+  double max_truth_gap_s = 0.5;
 
-  auto* gateway = app.add_subcommand(
-      "gateway", "beacon-gateway: publish the beacon map, TOFs and odometry (simulated source)");
+  auto* gateway = app.add_subcommand("gateway", "beacon-gateway: publish the beacon map, TOFs, odometry and scans");
   add_dds_options(gateway, dds_options);
-  add_gateway_options(gateway, gateway_options);
-  std::string source = "sim";
-  gateway->add_option("--source", source, "data source")->check(CLI::IsMember({"sim"}));
+  add_source_options(gateway, source_choice);
+  add_gateway_options(gateway, gateway_options, seed);
 
-  auto* decoder = app.add_subcommand("decoder", "decoder: RawTof -> BeaconRange, rejecting bad TOFs");
+  auto* decoder = app.add_subcommand("decoder", "decoder: RawTof -> BeaconRange, refusing bad TOFs");
   add_dds_options(decoder, dds_options);
   add_decoder_options(decoder, decoder_config, max_age_ms);
 
-  auto* localizer =
-      app.add_subcommand("localizer", "localizer: odometry + ranges -> pose, one estimator plugin");
+  auto* localizer = app.add_subcommand("localizer", "localizer: odometry + ranges -> pose, one estimator plugin");
   add_dds_options(localizer, dds_options);
-  add_localizer_options(localizer, localizer_options, true);
+  add_localizer_options(localizer, localizer_settings, true);
   localizer->add_flag("--list-estimators", list_estimators, "print the estimators and exit");
 
-  auto* demo = app.add_subcommand(
-      "demo", "the whole pipeline in one process on the built-in scenario; prints the accuracy");
+  auto* demo = app.add_subcommand("demo", "the whole pipeline in one process on the built-in scenario, in real time");
   add_dds_options(demo, dds_options);
-  add_gateway_options(demo, gateway_options);
-  add_localizer_options(demo, localizer_options, false);
-  demo->add_option("--out", demo_out, "write truth.csv and estimate.csv into this directory");
-  gateway_options.duration_s = 0.0;
-  demo->callback([&] {
-    if (gateway_options.duration_s == 0.0) gateway_options.duration_s = 20.0;  // demo default
-    if (!demo_out.empty()) {
-      std::filesystem::create_directories(demo_out);
-      if (gateway_options.truth_csv.empty()) gateway_options.truth_csv = demo_out + "/truth.csv";
-    }
-  });
+  add_gateway_options(demo, gateway_options, seed);
+  add_localizer_options(demo, localizer_settings, false);
+  demo->add_option("--out", out_dir, "write truth, estimates, metrics and plots into this directory");
 
-  auto* monitor = app.add_subcommand(
-      "monitor", "print the poses on the bus each second; with --truth, the accuracy at the end");
+  auto* run_cmd = app.add_subcommand(
+      "run", "gateway, decoder and localizer over DDS on a scenario or a recording, as fast as they go; "
+             "writes truth.csv, estimate.csv, metrics.json and plots");
+  add_dds_options(run_cmd, dds_options);
+  add_source_options(run_cmd, source_choice);
+  add_gateway_options(run_cmd, gateway_options, seed);
+  add_decoder_options(run_cmd, decoder_config, max_age_ms);
+  add_localizer_options(run_cmd, localizer_settings, false);
+  run_cmd->add_option("--out", out_dir, "output directory")->required();
+  run_cmd->add_flag("--processes", processes, "one process per participant (needs --speed)");
+
+  auto* eval = app.add_subcommand("eval", "score an estimate CSV against a truth CSV: metrics.json and plots");
+  eval->add_option("--truth", truth_file, "truth CSV (stamp_ns,x_m,y_m,yaw_rad)")->required()->check(CLI::ExistingFile);
+  eval->add_option("--estimate", estimate_file, "estimate CSV written by run or demo")->required()->check(CLI::ExistingFile);
+  eval->add_option("--out", out_dir, "output directory")->required();
+  eval->add_option("--beacons", beacons_file, "beacons CSV to draw (beacon_id,x_m,y_m,z_m)")->check(CLI::ExistingFile);
+  eval->add_option("--max-truth-gap-s", max_truth_gap_s, "interpolate truth over gaps up to this long")->check(kPositive);
+
+  auto* monitor = app.add_subcommand("monitor", "print the poses on the bus each second; with --truth, the accuracy at the end");
   add_dds_options(monitor, dds_options);
   monitor->add_option("--duration-s", monitor_duration_s, "stop after this many seconds (0: until stopped)")
       ->check(kNonNegative);
-  monitor->add_option("--truth", monitor_truth, "ground truth CSV written by the gateway");
-  monitor->add_option("--out", monitor_out, "write the poses to this CSV");
+  monitor->add_option("--truth", truth_file, "ground truth CSV written by the gateway");
+  monitor->add_option("--out", estimate_file, "write the poses to this CSV");
 
   CLI11_PARSE(app, argc, argv);
   dds::install_stop_handlers();
+  decoder_config.max_age_ns = static_cast<StampNs>(max_age_ms * 1e6);
 
   try {
     if (gateway->parsed()) {
-      GatewayParticipant participant(dds_options, gateway_options, sim::default_scenario());
+      LoadedSource source = load_source(source_choice, seed);
+      gateway_options.seed = source.seed;
+      GatewayParticipant participant(dds_options, gateway_options, std::move(source.source));
       participant.start();
       while (!participant.finished() && !dds::wait_for_stop(100ms)) {
       }
@@ -194,7 +180,6 @@ int run(int argc, char** argv) {
       return 0;
     }
     if (decoder->parsed()) {
-      decoder_config.max_age_ns = static_cast<StampNs>(max_age_ms * 1e6);
       DecoderParticipant participant(dds_options, decoder_config);
       run_until_stopped();
       return 0;
@@ -207,14 +192,16 @@ int run(int argc, char** argv) {
         return 0;
       }
       LocalizerParticipant participant(
-          dds_options,
-          LocalizerCore(localizer_options.estimator, localizer_options.config(), localizer_options.robot));
+          dds_options, LocalizerCore(localizer_settings.estimator, localizer_settings.config(), localizer_settings.robot));
       run_until_stopped();
       return 0;
     }
+    if (eval->parsed()) {
+      const Metrics m = evaluate_files(truth_file, estimate_file, out_dir, beacons_file, max_truth_gap_s);
+      std::cout << format_metrics(m) << "\nwrote " << out_dir << "/metrics.json, trajectory.svg, error.svg\n";
+      return m.samples ? 0 : 1;
+    }
     if (monitor->parsed()) {
-      TruthTrack truth;
-      if (!monitor_truth.empty()) truth = load_truth_csv(monitor_truth);
       PoseRecorder recorder(dds_options);
       DiagnosticsRecorder diagnostics(dds_options);
       const auto start = std::chrono::steady_clock::now();
@@ -222,7 +209,7 @@ int run(int argc, char** argv) {
       while (!dds::wait_for_stop(1s)) {
         const auto poses = recorder.poses();
         if (poses.size() > shown) {
-          const auto& p = poses.back();
+          const auto& p = poses.back().row;
           std::printf("%s %s: %zu poses (+%zu), x %.3f m, y %.3f m, yaw %.1f deg, %s\n", p.robot_id.c_str(),
                       p.estimator.c_str(), poses.size(), poses.size() - shown, p.estimate.pose_map_base.x(),
                       p.estimate.pose_map_base.y(), p.estimate.pose_map_base.z() * 180.0 / M_PI,
@@ -235,64 +222,47 @@ int run(int argc, char** argv) {
           break;
         }
       }
-      if (!monitor_truth.empty()) truth = load_truth_csv(monitor_truth);  // the gateway kept writing
       const auto poses = recorder.poses();
-      if (!monitor_out.empty()) write_poses_csv(monitor_out, poses);
+      if (!estimate_file.empty()) write_estimates_csv(estimate_file, rows_of(poses));
       print_diagnostics(diagnostics.latest(), std::cout);
-      print_summary(summarize(poses, truth), std::cout);
+      if (!truth_file.empty()) {
+        const PoseRunSummary s = summarize(poses, load_truth_csv(truth_file));
+        std::printf("poses: %zu at %.1f Hz; %s\n", s.poses, s.pose_rate_hz, format_metrics(s.metrics).c_str());
+      }
       return 0;
     }
-    if (demo->parsed()) {
-      std::mutex truth_mutex;
-      TruthTrack truth;
-      LocalizerParticipant localizer_participant(
-          dds_options,
-          LocalizerCore(localizer_options.estimator, localizer_options.config(), localizer_options.robot));
-      DecoderParticipant decoder_participant(dds_options, decoder_config);
-      PoseRecorder recorder(dds_options);
-      DiagnosticsRecorder diagnostics(dds_options);
-      GatewayParticipant gateway_participant(dds_options, gateway_options, sim::default_scenario(),
-                                             [&](StampNs stamp, const Pose2& pose) {
-                                               std::lock_guard<std::mutex> lock(truth_mutex);
-                                               truth.add(stamp, pose);
-                                             });
-      std::cout << "beaconloc demo: " << sim::default_scenario().name << ", estimator "
-                << localizer_options.estimator << ", " << gateway_options.duration_s << " s simulated at x"
-                << gateway_options.speed << '\n';
-      gateway_participant.start();
-      double next_report_s = 1.0;
-      const auto start = std::chrono::steady_clock::now();
-      while (!gateway_participant.finished() && !dds::wait_for_stop(100ms)) {
-        const double elapsed_s =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() *
-            gateway_options.speed;
-        if (elapsed_s >= next_report_s) {
-          const auto poses = recorder.poses();
-          if (!poses.empty()) {
-            const auto& p = poses.back().estimate;
-            std::printf("t=%5.1f s  pose x %.3f m  y %.3f m  yaw %6.1f deg  %s\n", elapsed_s,
-                        p.pose_map_base.x(), p.pose_map_base.y(), p.pose_map_base.z() * 180.0 / M_PI,
-                        to_string(p.status));
-          } else {
-            std::printf("t=%5.1f s  no pose yet (initializing from beacons)\n", elapsed_s);
-          }
-          std::fflush(stdout);
-          next_report_s += 1.0;
-        }
+    if (demo->parsed() || run_cmd->parsed()) {
+      PipelineOptions o;
+      o.dds = dds_options;
+      o.decoder = decoder_config;
+      o.localizer = localizer_settings;
+      o.out_dir = out_dir;
+      o.processes = processes;
+      LoadedSource source = load_source(source_choice, seed);
+      o.gateway = gateway_options;
+      o.gateway.seed = source.seed;
+      if (demo->parsed()) {
+        if (demo->count("--duration-s") == 0) o.gateway.duration_s = 20.0;
+        o.print_poses = true;
+      } else {
+        if (run_cmd->count("--speed") == 0) o.gateway.speed = processes ? 10.0 : 0.0;  // 0: as fast as it goes
+        if (run_cmd->count("--duration-s") == 0 && source.scenario) o.gateway.duration_s = source.scenario->duration_s;
+        o.print_progress = true;
       }
-      gateway_participant.stop();
-      gateway_participant.rethrow_failure();
-      std::this_thread::sleep_for(300ms);  // let the last samples through the pipeline
-      const auto poses = recorder.poses();
-      std::lock_guard<std::mutex> lock(truth_mutex);
-      if (!demo_out.empty()) {
-        write_poses_csv(demo_out + "/estimate.csv", poses);
+      if (!out_dir.empty() && o.gateway.truth_csv.empty() && !processes) o.gateway.truth_csv = out_dir + "/truth.csv";
+      if (run_cmd->parsed()) {
+        o.gateway.wall_clock_stamps = false;  // the same seed gives byte-identical files
+        if (!processes) o.gateway.record_dir = out_dir;
       }
-      const PoseRunSummary summary = summarize(poses, truth);
-      print_diagnostics(diagnostics.latest(), std::cout);
-      print_summary(summary, std::cout);
-      if (summary.error.samples() == 0) {
-        std::cerr << "beaconloc demo: no pose was estimated\n";
+      std::cout << "beaconloc " << (demo->parsed() ? "demo" : "run") << ": " << source.label << ", estimator "
+                << o.localizer.estimator << ", seed " << source.seed << '\n';
+      std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe");
+      const PipelineResult r = run_pipeline(o, std::move(source), self.string());
+      std::cout << r.diagnostics;
+      std::printf("poses: %zu at %.1f Hz; %s\n", r.poses, r.pose_rate_hz, format_metrics(r.metrics).c_str());
+      if (!out_dir.empty()) std::cout << "wrote " << out_dir << "/{truth,estimate,beacons}.csv, metrics.json, trajectory.svg, error.svg\n";
+      if (r.metrics.samples == 0) {
+        std::cerr << "beaconloc: no pose was estimated\n";
         return 1;
       }
       return 0;

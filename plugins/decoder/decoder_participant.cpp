@@ -32,7 +32,10 @@ void DecoderParticipant::on_raw_tof(const msg::RawTof& m) {
     std::lock_guard<std::mutex> lock(mutex_);
     outcome = decoder_.decode(m.robot_id(), dds::from_msg(m));
   }
-  if (!outcome.range) return;
+  if (!outcome.range) {
+    ++tofs_processed_;
+    return;
+  }
   const DecodedRange& d = *outcome.range;
   msg::BeaconRange out;
   out.robot_id(m.robot_id());
@@ -45,6 +48,8 @@ void DecoderParticipant::on_raw_tof(const msg::RawTof& m) {
   out.association(d.associated ? msg::RANGE_ASSOCIATION_BY_ID : msg::RANGE_ASSOCIATION_UNASSOCIATED);
   out.source_sequence_number(d.source_sequence_number);
   range_writer_->write(&out);
+  ++ranges_written_;  // before tofs_processed_: a throttle never sees the TOF done, the range not sent
+  ++tofs_processed_;
 }
 
 msg::Diagnostics DecoderParticipant::diagnostics_snapshot() {

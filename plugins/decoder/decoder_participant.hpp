@@ -16,6 +16,14 @@ class DecoderParticipant {
  public:
   DecoderParticipant(const dds::DdsOptions& dds, TofDecoderConfig config);
   ~DecoderParticipant();
+  void publish_diagnostics() { diagnostics_->publish_now(); }
+  // Waits until the range writer has a matched reader (false on timeout).
+  bool wait_for_readers(std::chrono::milliseconds timeout) const {
+    return dds::wait_for_matched_readers({range_writer_}, timeout);
+  }
+  // TOFs taken from the bus and ranges written, for a throttle in the same process.
+  std::uint64_t tofs_processed() const { return tofs_processed_.load(); }
+  std::uint64_t ranges_written() const { return ranges_written_.load(); }
 
  private:
   msg::Diagnostics diagnostics_snapshot();
@@ -24,6 +32,8 @@ class DecoderParticipant {
   std::mutex mutex_;
   TofDecoder decoder_;
   std::atomic<std::uint64_t> deadline_misses_{0};
+  std::atomic<std::uint64_t> tofs_processed_{0};
+  std::atomic<std::uint64_t> ranges_written_{0};
   dds::Participant participant_;
   eprosima::fastdds::dds::DataWriter* range_writer_;
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;

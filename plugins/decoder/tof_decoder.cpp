@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "beaconloc/core/speed_of_sound.hpp"
 
@@ -36,6 +37,13 @@ DecodeOutcome TofDecoder::reject(TofRejection r) {
   return out;
 }
 
+TofDecoder::TofDecoder(TofDecoderConfig config) : config_(config) {
+  if (!(config_.range_scale > 0.0) || !std::isfinite(config_.range_scale)) {
+    throw std::invalid_argument("range_scale must be a positive number");
+  }
+  if (!(config_.max_range_m > config_.min_range_m)) throw std::invalid_argument("max_range_m must exceed min_range_m");
+}
+
 DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample& tof) {
   if (!std::isfinite(tof.tof_s)) return reject(TofRejection::kNonFiniteTof);
   if (!(tof.tof_s > 0.0)) return reject(TofRejection::kNegativeTof);
@@ -43,7 +51,7 @@ DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample
   if (!std::isfinite(t_c) || t_c < config_.min_temperature_c || t_c > config_.max_temperature_c) {
     return reject(TofRejection::kBadTemperature);
   }
-  const double range_m = speed_of_sound_mps(t_c) * tof.tof_s;
+  const double range_m = speed_of_sound_mps(t_c) * tof.tof_s / config_.range_scale;
   if (range_m < config_.min_range_m || range_m > config_.max_range_m) {
     return reject(TofRejection::kOutOfRangeTof);
   }

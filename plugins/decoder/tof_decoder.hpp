@@ -33,6 +33,10 @@ struct TofDecoderConfig {
   double min_temperature_c = -30.0;
   double max_temperature_c = 60.0;
   StampNs max_age_ns = 600 * kNsPerMillisecond;  // three 200 ms slots
+  // Calibration of the ranging system: range = c * tof / range_scale. 1 for ultrasonic TOF;
+  // e.g. 1.069 for the radios of the CMU Plaza recordings (datasets/README.md), whose ranges
+  // read 6.9 % long.
+  double range_scale = 1.0;
 };
 
 struct DecodedRange {
@@ -49,7 +53,7 @@ struct DecodeOutcome {
 
 class TofDecoder {
  public:
-  explicit TofDecoder(TofDecoderConfig config = {}) : config_(config) {}
+  explicit TofDecoder(TofDecoderConfig config = {});  // throws std::invalid_argument
   void set_beacon_map(const BeaconMap& map) { map_ = map; }
   bool has_beacon_map() const { return !map_.empty(); }
   DecodeOutcome decode(const std::string& robot_id, const RawTofSample& tof);

@@ -8,32 +8,49 @@
 
 #include "beaconloc/dds/convert.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
-#include "sim/sim_source.hpp"
 
 namespace beaconloc {
 
 GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOptions options,
-                                       sim::Scenario scenario, TruthCallback on_truth)
+                                       std::unique_ptr<Source> source, TruthCallback on_truth, Throttle throttle)
     : options_(std::move(options)),
-      scenario_(std::move(scenario)),
+      source_(std::move(source)),
       on_truth_(std::move(on_truth)),
+      throttle_(std::move(throttle)),
       participant_(dds, "beaconloc.gateway." + options_.robot_id),
       map_writer_(participant_.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic)),
       tof_writer_(participant_.writer<msg::RawTofPubSubType>(dds::kRawTofTopic)),
-      odometry_writer_(participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic)) {
-  if (!(options_.speed > 0.0)) throw std::invalid_argument("--speed must be > 0");
-  if (options_.duration_s < 0.0) throw std::invalid_argument("--duration-s must be >= 0");
+      odometry_writer_(participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic)),
+      scan_writer_(participant_.writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic)) {
+  if (!(options_.speed >= 0.0)) throw std::invalid_argument("--speed must be >= 0");
+  if (!(options_.duration_s >= 0.0)) throw std::invalid_argument("--duration-s must be >= 0");
   if (!options_.truth_csv.empty()) {
     truth_.open(options_.truth_csv);
     if (!truth_) throw std::runtime_error("cannot write truth file '" + options_.truth_csv + "'");
     truth_ << "stamp_ns,x_m,y_m,yaw_rad\n" << std::setprecision(10);
   }
+  if (!options_.record_dir.empty()) {
+    record_tof_.open(options_.record_dir + "/tof.csv");
+    record_odometry_.open(options_.record_dir + "/odometry.csv");
+    if (!record_tof_ || !record_odometry_) {
+      throw std::runtime_error("cannot write tof.csv and odometry.csv in '" + options_.record_dir + "'");
+    }
+    record_tof_ << "fire_stamp_ns,beacon_id,receiver_id,tof_s,beacon_temperature_c,sequence_number,"
+                   "true_beacon_id,echo\n"
+                << std::setprecision(12);
+    record_odometry_ << "stamp_ns,wheel_velocity_right_mps,wheel_velocity_left_mps,wheel_base_m,var_right,var_left\n"
+                     << std::setprecision(12);
+  }
+  const double source_s = ns_to_s(source_->last_stamp_ns() - source_->first_stamp_ns());
+  total_s_ = options_.duration_s > 0.0 ? options_.duration_s : source_s;
   diagnostics_ = std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] {
     std::lock_guard<std::mutex> lock(counts_mutex_);
-    return dds::make_diagnostics(
-        participant_.name(), dds::wall_clock_ns(), counts_, 0,
-        counts_.rejected_total() ? msg::PARTICIPANT_STATUS_DEGRADED : msg::PARTICIPANT_STATUS_OK,
-        "simulated source, robot " + options_.robot_id);
+    RejectionCounter counts = counts_;
+    counts.add_rejections(source_->input_rejections(), "source.");
+    return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, 0,
+                                 counts.rejected_total() ? msg::PARTICIPANT_STATUS_DEGRADED
+                                                         : msg::PARTICIPANT_STATUS_OK,
+                                 source_->describe() + ", robot " + options_.robot_id);
   });
 }
 
@@ -43,9 +60,11 @@ GatewayParticipant::~GatewayParticipant() {
   participant_.close();
 }
 
-void GatewayParticipant::start() {
-  thread_ = std::thread([this] { run(); });
+bool GatewayParticipant::wait_for_readers(std::chrono::milliseconds timeout) const {
+  return dds::wait_for_matched_readers({tof_writer_, odometry_writer_}, timeout);
 }
+
+void GatewayParticipant::start() { thread_ = std::thread([this] { run(); }); }
 
 void GatewayParticipant::stop() {
   stop_ = true;
@@ -65,47 +84,87 @@ void GatewayParticipant::count(bool written) {
   }
 }
 
+void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
+  const StampNs stamp = e.stamp_ns + offset_ns;
+  if (e.has_truth) {
+    if (truth_.is_open()) {
+      truth_ << stamp << ',' << e.truth_map_base.x() << ',' << e.truth_map_base.y() << ',';
+      if (e.truth_has_yaw) truth_ << e.truth_map_base.z();
+      truth_ << '\n';
+    }
+    if (on_truth_) on_truth_(stamp, e.truth_map_base, e.truth_has_yaw);
+  }
+  switch (e.kind) {
+    case SourceEvent::Kind::kTof: {
+      e.tof.fire_stamp_ns += offset_ns;
+      if (record_tof_.is_open()) {
+        const auto& t = e.tof;
+        record_tof_ << t.fire_stamp_ns << ',' << t.beacon_id << ',' << t.receiver_id << ',' << t.tof_s << ','
+                    << t.beacon_temperature_c << ',' << t.sequence_number << ',' << e.true_beacon_id << ','
+                    << e.tof_is_echo << '\n';
+      }
+      auto m = dds::to_msg(options_.robot_id, e.tof);
+      count(tof_writer_->write(&m));  // bool in Fast DDS 2.9 (TOOLCHAIN.md)
+      ++progress_.tofs_written;
+      break;
+    }
+    case SourceEvent::Kind::kOdometry: {
+      e.odometry.stamp_ns = stamp;
+      if (record_odometry_.is_open()) {
+        const auto& o = e.odometry;
+        record_odometry_ << o.stamp_ns << ',' << o.wheel_velocity_right_mps << ',' << o.wheel_velocity_left_mps << ','
+                         << o.wheel_base_m << ',' << o.wheel_velocity_covariance(0, 0) << ','
+                         << o.wheel_velocity_covariance(1, 1) << '\n';
+      }
+      auto m = dds::to_msg(options_.robot_id, e.odometry, odometry_sequence_++);
+      count(odometry_writer_->write(&m));
+      ++progress_.odometry_written;
+      break;
+    }
+    case SourceEvent::Kind::kLaserScan: {
+      e.scan.stamp_ns = stamp;
+      auto m = dds::to_msg(options_.robot_id, e.scan);
+      count(scan_writer_->write(&m));
+      break;
+    }
+    case SourceEvent::Kind::kTruth:
+      break;
+  }
+  progress_.newest_stamp_ns = stamp;
+}
+
 void GatewayParticipant::run() {
   using clock = std::chrono::steady_clock;
-  // Sim stamps are offset to the wall clock at start, so live consumers see real times.
-  const StampNs epoch_ns = dds::wall_clock_ns();
-  auto beacon_map = dds::to_msg(BeaconMap(scenario_.beacons), options_.frame_id);
-  map_writer_->write(&beacon_map);
+  // Simulated stamps start at 0: offset them to the wall clock at start, so live consumers see
+  // real times. A recording keeps its own clock.
+  const StampNs offset_ns = source_->relative_stamps() && options_.wall_clock_stamps ? dds::wall_clock_ns() : 0;
+  auto beacon_map = dds::to_msg(source_->beacon_map(), options_.frame_id);
+  count(map_writer_->write(&beacon_map));
 
-  sim::SimSource source(scenario_, options_.seed);
-  std::vector<sim::SimEvent> events;
-  const StampNs step_ns = scenario_.odometry_period_ns;
-  const StampNs end_ns = options_.duration_s > 0.0 ? s_to_ns(options_.duration_s) : -1;
+  std::vector<SourceEvent> events;
+  const StampNs step_ns = 10 * kNsPerMillisecond;
+  const StampNs begin_ns = source_->first_stamp_ns();
+  // With a duration: that much source time. Without: a recording to its end, a simulation
+  // until stopped.
+  const bool bounded = options_.duration_s > 0.0 || source_->finite();
+  const StampNs last_ns =
+      options_.duration_s > 0.0 ? begin_ns + s_to_ns(options_.duration_s) : source_->last_stamp_ns();
   const auto wall_start = clock::now();
-  std::uint64_t odometry_sequence = 0;
-  for (StampNs sim_ns = step_ns; !stop_ && (end_ns < 0 || sim_ns <= end_ns); sim_ns += step_ns) {
+  for (StampNs t_ns = begin_ns; !stop_ && !(bounded && t_ns - step_ns >= last_ns); t_ns += step_ns) {
     events.clear();
-    source.advance(sim_ns, events);
-    std::this_thread::sleep_until(wall_start + std::chrono::nanoseconds(static_cast<StampNs>(
-                                                   static_cast<double>(sim_ns) / options_.speed)));
-    for (auto& e : events) {
-      bool written = false;
-      if (e.kind == sim::SimEvent::Kind::kTof) {
-        e.tof.fire_stamp_ns += epoch_ns;
-        auto m = dds::to_msg(options_.robot_id, e.tof);
-        written = tof_writer_->write(&m);  // bool in Fast DDS 2.9 (TOOLCHAIN.md)
-      } else {
-        e.odometry.stamp_ns += epoch_ns;
-        auto m = dds::to_msg(options_.robot_id, e.odometry, odometry_sequence++);
-        written = odometry_writer_->write(&m);
-        const StampNs stamp = e.odometry.stamp_ns;
-        if (truth_) {
-          truth_ << stamp << ',' << e.truth_map_base.x() << ',' << e.truth_map_base.y() << ','
-                 << e.truth_map_base.z() << '\n';
-        }
-        if (on_truth_) on_truth_(stamp, e.truth_map_base);
-      }
-      count(written);
+    source_->advance(bounded ? std::min(t_ns, last_ns) : t_ns, events);
+    if (options_.speed > 0.0) {
+      const auto wall_offset = std::chrono::nanoseconds(
+          static_cast<StampNs>(static_cast<double>(t_ns - begin_ns) / options_.speed));
+      std::this_thread::sleep_until(wall_start + wall_offset);
     }
+    for (auto& e : events) publish(e, offset_ns);
+    elapsed_s_ = ns_to_s(std::min(t_ns, bounded ? last_ns : t_ns) - begin_ns);
+    if (throttle_) throttle_();
+    if (source_->exhausted()) break;
   }
-  if (truth_) {
-    truth_.flush();
-    if (!truth_) failure_ = "writing truth file '" + options_.truth_csv + "' failed";
+  for (auto* file : {&truth_, &record_tof_, &record_odometry_}) {
+    if (file->is_open() && !file->flush()) failure_ = "writing the gateway's output files failed";
   }
   diagnostics_->publish_now();
   finished_ = true;

@@ -1,7 +1,9 @@
 #pragma once
-// beacon-gateway participant: publishes the BeaconMap (transient local), RawTof and Odometry
-// from a source. Source here: the simulator, paced against the wall clock (x speed).
+// beacon-gateway participant: publishes the source's BeaconMap (transient local), then its
+// RawTof, Odometry and LaserScan samples, paced against the wall clock (x speed) or as fast as a
+// throttle lets it; writes the source's ground truth to a CSV when asked.
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <fstream>
 #include <functional>
@@ -13,48 +15,80 @@
 #include "beaconloc/core/rejection_counter.hpp"
 #include "beaconloc/dds/diagnostics_publisher.hpp"
 #include "beaconloc/dds/participant.hpp"
-#include "sim/scenario.hpp"
+#include "source.hpp"
 
 namespace beaconloc {
 
 struct GatewayOptions {
   std::string robot_id = "robot1";
-  double duration_s = 0.0;  // simulated seconds to run; 0 = until stopped
-  double speed = 1.0;       // simulated seconds per wall second
+  double duration_s = 0.0;  // seconds of source time to run; 0 = the whole source / until stopped
+  double speed = 1.0;       // source seconds per wall second; 0 = as fast as the throttle allows
   std::uint64_t seed = 1;
-  std::string truth_csv;  // ground truth written here when not empty
+  std::string truth_csv;    // ground truth written here when not empty
+  // The samples written, as CSV (tof.csv, odometry.csv, with the simulator's hidden truth: who
+  // fired, echo or not), when not empty.
+  std::string record_dir;
   std::string frame_id = "map";
+  // Simulated stamps start at 0; live, they are offset to the wall clock at start. A replayed
+  // recording keeps its own clock either way. false: byte-identical runs (run).
+  bool wall_clock_stamps = true;
+};
+
+// What the gateway has written so far (read by a throttle in the same process).
+struct GatewayProgress {
+  std::atomic<std::uint64_t> odometry_written{0};
+  std::atomic<std::uint64_t> tofs_written{0};
+  std::atomic<StampNs> newest_stamp_ns{0};
 };
 
 class GatewayParticipant {
  public:
-  // Truth of every odometry stamp, for evaluation in the same process.
-  using TruthCallback = std::function<void(StampNs stamp_ns, const Pose2& truth_map_base)>;
+  // Truth of the source at a stamp (the stamp the published samples carry).
+  using TruthCallback = std::function<void(StampNs stamp_ns, const Pose2& truth_map_base, bool has_yaw)>;
+  // Called after each step's samples are written; may block to hold the gateway back.
+  using Throttle = std::function<void()>;
 
-  GatewayParticipant(const dds::DdsOptions& dds, GatewayOptions options, sim::Scenario scenario,
-                     TruthCallback on_truth = {});
+  GatewayParticipant(const dds::DdsOptions& dds, GatewayOptions options, std::unique_ptr<Source> source,
+                     TruthCallback on_truth = {}, Throttle throttle = {});
   ~GatewayParticipant();
+  // Waits until the TOF and odometry writers each have a matched reader (false on timeout), so
+  // that a run in one process loses none of its first samples.
+  bool wait_for_readers(std::chrono::milliseconds timeout) const;
   void start();
   void stop();
+  void publish_diagnostics() { diagnostics_->publish_now(); }
   bool finished() const { return finished_.load(); }
+  const GatewayProgress& progress() const { return progress_; }
+  // Source time covered so far, and in all, for progress lines.
+  double elapsed_s() const { return elapsed_s_.load(); }
+  double total_s() const { return total_s_; }
   // Throws if the run loop failed (e.g. the truth file could not be written).
   void rethrow_failure() const;
 
  private:
   void run();
+  void publish(SourceEvent& e, StampNs offset_ns);
   void count(bool written);
 
   GatewayOptions options_;
-  sim::Scenario scenario_;
+  std::unique_ptr<Source> source_;
   TruthCallback on_truth_;
+  Throttle throttle_;
   dds::Participant participant_;
   eprosima::fastdds::dds::DataWriter* map_writer_;
   eprosima::fastdds::dds::DataWriter* tof_writer_;
   eprosima::fastdds::dds::DataWriter* odometry_writer_;
+  eprosima::fastdds::dds::DataWriter* scan_writer_;
   std::ofstream truth_;
+  std::ofstream record_tof_;
+  std::ofstream record_odometry_;
+  std::uint64_t odometry_sequence_ = 0;
   std::mutex counts_mutex_;
   RejectionCounter counts_;  // accepted = samples written; rejected = write failures
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
+  GatewayProgress progress_;
+  std::atomic<double> elapsed_s_{0.0};
+  double total_s_ = 0.0;
   std::atomic<bool> stop_{false};
   std::atomic<bool> finished_{false};
   std::string failure_;

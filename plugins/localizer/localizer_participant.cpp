@@ -18,8 +18,11 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
   participant_.subscribe<msg::BeaconRangePubSubType>(
       dds::kBeaconRangeTopic,
       [this](const msg::BeaconRange& m) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        core_.on_range(m.robot_id(), dds::from_msg(m));
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          core_.on_range(m.robot_id(), dds::from_msg(m));
+        }
+        ++ranges_processed_;
       },
       &deadline_misses_);
   participant_.subscribe<msg::OdometryPubSubType>(
@@ -39,9 +42,11 @@ void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
     std::lock_guard<std::mutex> lock(mutex_);
     out = core_.on_odometry(m.robot_id(), dds::from_msg(m));
   }
-  if (!out) return;
-  auto p = dds::to_msg(out->robot_id, out->estimate, core_.estimator_name(), out->beacons_used);
-  pose_writer_->write(&p);
+  if (out) {
+    auto p = dds::to_msg(out->robot_id, out->estimate, core_.estimator_name(), out->beacons_used);
+    pose_writer_->write(&p);
+  }
+  ++odometry_processed_;
 }
 
 msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {

@@ -17,6 +17,10 @@ class LocalizerParticipant {
  public:
   LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core);
   ~LocalizerParticipant();
+  void publish_diagnostics() { diagnostics_->publish_now(); }
+  // Samples taken from the bus, for a throttle in the same process.
+  std::uint64_t odometry_processed() const { return odometry_processed_.load(); }
+  std::uint64_t ranges_processed() const { return ranges_processed_.load(); }
 
  private:
   msg::Diagnostics diagnostics_snapshot();
@@ -25,6 +29,8 @@ class LocalizerParticipant {
   std::mutex mutex_;
   LocalizerCore core_;
   std::atomic<std::uint64_t> deadline_misses_{0};
+  std::atomic<std::uint64_t> odometry_processed_{0};
+  std::atomic<std::uint64_t> ranges_processed_{0};
   dds::Participant participant_;
   eprosima::fastdds::dds::DataWriter* pose_writer_;
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;

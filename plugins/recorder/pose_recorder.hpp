@@ -1,21 +1,18 @@
 #pragma once
-// Records the PoseEstimate topic with the wall time each pose arrived: the demo and the tests
-// measure accuracy against ground truth and the pose rate with it.
+// Records the PoseEstimate topic with the wall time each pose arrived: the demo, `run`,
+// `monitor` and the tests measure accuracy against ground truth and the pose rate with it.
 #include <chrono>
-#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
-#include "beaconloc/core/estimator.hpp"
 #include "beaconloc/dds/participant.hpp"
+#include "evaluation.hpp"
 
 namespace beaconloc {
 
 struct RecordedPose {
-  std::string robot_id;
-  PoseEstimate estimate;
-  std::string estimator;
+  EstimateRow row;
   std::chrono::steady_clock::time_point received;
 };
 
@@ -24,6 +21,8 @@ class PoseRecorder {
   explicit PoseRecorder(const dds::DdsOptions& dds);
   ~PoseRecorder();
   std::vector<RecordedPose> poses() const;
+  std::size_t count() const;
+  StampNs newest_stamp_ns() const;  // 0 before the first pose
 
  private:
   mutable std::mutex mutex_;
@@ -31,26 +30,14 @@ class PoseRecorder {
   dds::Participant participant_;
 };
 
-// Writes poses as CSV: robot_id,stamp_ns,x_m,y_m,yaw_rad,cov_xx,cov_yy,cov_yawyaw,status.
-void write_poses_csv(const std::string& path, const std::vector<RecordedPose>& poses);
-
-}  // namespace beaconloc
-
-#include "beaconloc/core/pose_error.hpp"
-#include "beaconloc/core/truth_track.hpp"
-
-namespace beaconloc {
-
-// Reads a truth CSV written by the gateway (stamp_ns,x_m,y_m,yaw_rad). Throws naming the file
-// and line of a malformed row.
-TruthTrack load_truth_csv(const std::string& path);
+std::vector<EstimateRow> rows_of(const std::vector<RecordedPose>& poses);
 
 struct PoseRunSummary {
   std::size_t poses = 0;
-  double pose_rate_hz = 0.0;   // poses / arrival time span
-  PoseErrorAccumulator error;  // over poses whose stamp the truth covers
-  std::size_t poses_without_truth = 0;
+  double pose_rate_hz = 0.0;  // poses / arrival time span
+  Metrics metrics;
 };
-PoseRunSummary summarize(const std::vector<RecordedPose>& poses, const TruthTrack& truth);
+PoseRunSummary summarize(const std::vector<RecordedPose>& poses, const TruthTrack& truth,
+                         const EvaluationOptions& options = {});
 
 }  // namespace beaconloc

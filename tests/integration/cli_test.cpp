@@ -22,11 +22,11 @@ std::pair<int, std::string> beaconloc(std::vector<std::string> args) {
 TEST(Cli, HelpEverywhere) {
   auto [code, out] = beaconloc({"--help"});
   EXPECT_EQ(code, 0);
-  for (const char* sub : {"gateway", "decoder", "localizer", "demo", "monitor"}) {
+  for (const char* sub : {"gateway", "decoder", "localizer", "demo", "run", "eval", "monitor"}) {
     EXPECT_NE(out.find(sub), std::string::npos) << sub;
     auto [sub_code, sub_out] = beaconloc({sub, "--help"});
     EXPECT_EQ(sub_code, 0) << sub;
-    EXPECT_NE(sub_out.find("--domain"), std::string::npos) << sub;
+    EXPECT_NE(sub_out.find(std::string(sub) == "eval" ? "--truth" : "--domain"), std::string::npos) << sub;
   }
 }
 
@@ -48,7 +48,8 @@ TEST(Cli, BadArgumentsAndConfigurationNameTheCulpritAndFail) {
       {{"gateway", "--speed", "-1"}, "--speed"},
       {{"gateway", "--speed", "fast"}, "--speed"},
       {{"gateway", "--duration-s", "-3"}, "--duration-s"},
-      {{"gateway", "--source", "serial"}, "--source"},
+      {{"gateway", "--replay", "/nonexistent/dir"}, "/nonexistent/dir"},
+      {{"gateway", "--scenario", "/nonexistent.yaml"}, "/nonexistent.yaml"},
       {{"decoder", "--max-range-m", "0"}, "--max-range-m"},
       {{"localizer", "--domain", "999"}, "--domain"},
       {{"localizer", "--estimator", "nope"}, "nope"},

@@ -14,10 +14,10 @@
 
 namespace beaconloc::testing {
 
-inline std::vector<sim::SimEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed,
+inline std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed,
                                            double duration_s) {
   sim::SimSource source(scenario, seed);
-  std::vector<sim::SimEvent> events;
+  std::vector<SourceEvent> events;
   source.advance(s_to_ns(duration_s), events);
   return events;
 }
@@ -30,13 +30,14 @@ struct OfflineStack {
     decoder.set_beacon_map(BeaconMap(scenario.beacons));
   }
   // One simulated event in; the pose the localizer would publish, on odometry events.
-  std::optional<LocalizerOutput> feed(const std::string& robot_id, const sim::SimEvent& e) {
-    if (e.kind == sim::SimEvent::Kind::kTof) {
+  std::optional<LocalizerOutput> feed(const std::string& robot_id, const SourceEvent& e) {
+    if (e.kind == SourceEvent::Kind::kTof) {
       if (const auto out = decoder.decode(robot_id, e.tof); out.range) {
         localizer.on_range(robot_id, out.range->range);
       }
       return std::nullopt;
     }
+    if (e.kind != SourceEvent::Kind::kOdometry) return std::nullopt;
     return localizer.on_odometry(robot_id, e.odometry);
   }
   static EstimatorConfig config_for(const sim::Scenario& scenario) {

@@ -26,7 +26,7 @@ TEST(LocalizerCore, KeepsRobotsApartOnSharedTopics) {
            std::find_if(eb.begin(), eb.end(), [](const auto& e) { return e.stamp_ns > s_to_ns(7.0); }));
   double worst = 0.0;
   std::set<std::uint32_t> used;
-  auto feed = [&](const std::string& robot, const sim::SimEvent& e) {
+  auto feed = [&](const std::string& robot, const SourceEvent& e) {
     if (auto pose = stack.feed(robot, e)) {
       if (e.stamp_ns > s_to_ns(robot == "a" ? 3.0 : 10.0)) {
         worst = std::max(worst, (pose->estimate.pose_map_base.head<2>() - e.truth_map_base.head<2>()).norm());

@@ -103,7 +103,7 @@ TEST(RangeEkf, DegradesWithoutRangesAndRecoversWhenTheyReturn) {
   PoseStatus at_8s = PoseStatus::kInitializing, at_20s = PoseStatus::kInitializing;
   for (const auto& e : testing::simulate(sim::default_scenario(), 2, 20.0)) {
     const double t = ns_to_s(e.stamp_ns);
-    const bool silenced = e.kind == sim::SimEvent::Kind::kTof && t > 5.0 && t < 8.0;
+    const bool silenced = e.kind == SourceEvent::Kind::kTof && t > 5.0 && t < 8.0;
     if (silenced) continue;  // the beacons fall silent for 3 s
     const auto pose = stack.feed("r", e);
     if (pose && std::abs(t - 7.9) < 0.005) at_8s = pose->estimate.status;

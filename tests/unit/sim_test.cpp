@@ -11,14 +11,14 @@
 namespace beaconloc::sim {
 namespace {
 
-std::vector<SimEvent> run(const Scenario& s, std::uint64_t seed, double seconds) {
+std::vector<SourceEvent> run(const Scenario& s, std::uint64_t seed, double seconds) {
   SimSource source(s, seed);
-  std::vector<SimEvent> events;
+  std::vector<SourceEvent> events;
   source.advance(s_to_ns(seconds), events);
   return events;
 }
 
-bool same(const SimEvent& a, const SimEvent& b) {
+bool same(const SourceEvent& a, const SourceEvent& b) {
   return a.kind == b.kind && a.stamp_ns == b.stamp_ns && a.tof.tof_s == b.tof.tof_s &&
          a.tof.beacon_id == b.tof.beacon_id &&
          a.odometry.wheel_velocity_right_mps == b.odometry.wheel_velocity_right_mps &&
@@ -39,7 +39,7 @@ TEST(SimSource, EventsComeInStampOrderAtTheScenarioRates) {
   const auto events = run(default_scenario(), 1, 10.0);
   std::size_t odometry = 0, tofs = 0;
   for (std::size_t i = 1; i < events.size(); ++i) ASSERT_LE(events[i - 1].stamp_ns, events[i].stamp_ns);
-  for (const auto& e : events) (e.kind == SimEvent::Kind::kOdometry ? odometry : tofs)++;
+  for (const auto& e : events) (e.kind == SourceEvent::Kind::kOdometry ? odometry : tofs)++;
   EXPECT_EQ(odometry, 1000u);  // 100 Hz
   EXPECT_EQ(tofs, 50u * 3u);   // 5 Hz slots x 3 receivers, every beacon in range
 }
@@ -50,7 +50,7 @@ TEST(SimSource, StaticRobotTofIsTheDistanceOverTheSpeedOfSound) {
   s.range_sigma_m = 0.0;
   const double c = speed_of_sound_mps(s.temperature_c);
   for (const auto& e : run(s, 1, 2.0)) {
-    if (e.kind != SimEvent::Kind::kTof) continue;
+    if (e.kind != SourceEvent::Kind::kTof) continue;
     const Eigen::Vector2d rx =
         transform_point(s.trajectory.pose_at(0.0), s.receivers.receivers_base_m[e.tof.receiver_id]);
     Eigen::Vector3d beacon = Eigen::Vector3d::Zero();
@@ -73,7 +73,7 @@ TEST(SimSource, MovingRobotHearsThePulseWhereItIsAtArrival) {
   const double c = speed_of_sound_mps(s.temperature_c);
   int checked = 0;
   for (const auto& e : run(s, 1, 2.0)) {
-    if (e.kind != SimEvent::Kind::kTof) continue;
+    if (e.kind != SourceEvent::Kind::kTof) continue;
     const double fire_s = ns_to_s(e.tof.fire_stamp_ns), arrival_s = fire_s + e.tof.tof_s;
     const Eigen::Vector3d beacon = s.beacons[0].position_map_m;
     auto distance_at = [&](double t) {
@@ -98,7 +98,7 @@ TEST(SimSource, NoiseFreeOdometryIntegratesToTheTruth) {
   StampNs last = 0;
   Pose2 truth = pose;
   for (const auto& e : run(s, 1, 30.0)) {
-    if (e.kind != SimEvent::Kind::kOdometry) continue;
+    if (e.kind != SourceEvent::Kind::kOdometry) continue;
     pose = predict_diff_drive(pose, e.odometry.wheel_velocity_right_mps, e.odometry.wheel_velocity_left_mps,
                               e.odometry.wheel_base_m, ns_to_s(e.stamp_ns - last))
                .pose;
@@ -116,7 +116,7 @@ TEST(SimSource, OdometryNoiseFollowsTheSpeedProportionalModel) {
   double sum = 0.0, sum_sq = 0.0;
   int n = 0;
   for (const auto& e : run(s, 3, 200.0)) {
-    if (e.kind != SimEvent::Kind::kOdometry) continue;
+    if (e.kind != SourceEvent::Kind::kOdometry) continue;
     const double err = e.odometry.wheel_velocity_right_mps - 0.34;
     sum += err;
     sum_sq += err * err;

@@ -6,7 +6,8 @@ namespace beaconloc::sim {
 
 Scenario default_scenario() {
   Scenario s;
-  s.name = "default (seed 000 setup, stadium loop)";
+  s.name = "default";
+  s.description = "seed 000 setup (six Txs at 2.011 m, three Rxs on a 0.19 m circle), stadium loop";
   const double z_t = 2.011;  // seed 000, trajectories 1-2
   std::uint32_t id = 1;
   for (double y : {-0.3, 1.5}) {

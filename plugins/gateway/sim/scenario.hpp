@@ -1,36 +1,75 @@
 #pragma once
-// A simulated world: ceiling beacons, the robot's receivers and wheels, a path, and the noise
-// of each sensor. The YAML scenario files of the simulator issue fill this same structure.
+// A simulated world: ceiling beacons, the robot's receivers and wheels, a path, the beacon
+// system's timing and physics, and optionally a map and a laser. Loaded from the YAML files of
+// examples/scenarios/ (schema in its README) or built in (default_scenario).
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "beaconloc/core/beacon_map.hpp"
+#include "beaconloc/core/occupancy_grid.hpp"
 #include "beaconloc/core/receiver_array.hpp"
 #include "beaconloc/core/time.hpp"
 #include "trajectory.hpp"
 
 namespace beaconloc::sim {
 
+struct EchoModel {
+  double probability = 0.0;       // per firing and receiver: the first arrival is an echo
+  double min_extra_path_m = 0.3;  // extra path of the echo, uniform in [min, max]
+  double max_extra_path_m = 3.0;
+};
+
+struct LaserModel {
+  int beams = 19;
+  double fov_rad = M_PI;
+  StampNs period_ns = 22 * kNsPerMillisecond;
+  double range_sigma_m = 0.1;
+  double max_range_m = 8.0;
+  Pose2 mount_base = Pose2::Zero();  // in the robot frame
+};
+
 struct Scenario {
-  std::string name;
+  std::string name = "default";
+  std::string description;
+  std::uint64_t seed = 1;
+  double duration_s = 20.0;
+
   std::vector<Beacon> beacons;
+  // Beacon system.
   std::vector<std::uint32_t> firing_order;  // beacon ids, one per slot, cycled
-  ReceiverArray receivers;
-  double wheel_base_m = 0.33;
-  double odometry_k_v_m = 4e-4;                      // seed 000: sigma_v^2 = k_v |v| / dT per wheel
-  double range_sigma_m = 0.01;                       // seed 000: sigma_dd
-  double temperature_c = 22.0;                       // air temperature, reported by the beacons
-  double max_range_m = 5.0;                          // a receiver hears a beacon up to this slant range
   StampNs slot_period_ns = 200 * kNsPerMillisecond;  // 5 Hz firing slots
   StampNs first_slot_ns = 50 * kNsPerMillisecond;
+  bool identified = true;                     // false: anonymous pulses
+  std::optional<std::uint32_t> marked_beacon_id;  // recognisable even when anonymous
+  double range_sigma_m = 0.01;                // seed 000: sigma_dd
+  double tof_sigma_s = 0.0;                   // seed 002: arrival-time noise
+  double min_range_m = 0.0;                   // a receiver hears slant ranges in [min, max]
+  double max_range_m = 5.0;
+  double beam_half_angle_rad = M_PI / 2;      // cone around the beacon's downward axis
+  double temperature_c = 22.0;                // true air temperature
+  std::optional<double> reported_temperature_c;  // what beacons report; default: the truth
+  EchoModel echo;
+
+  // Robot.
+  ReceiverArray receivers;
+  double wheel_base_m = 0.33;
   StampNs odometry_period_ns = 10 * kNsPerMillisecond;  // 100 Hz
+  double odometry_k_v_m = 4e-4;               // seed 000: sigma_v^2 = k_v |v| / dT per wheel
+  double wheel_radius_error_right = 0.0;      // measured wheel speed = true * (1 + error)
+  double wheel_radius_error_left = 0.0;
+  double wheel_base_error = 0.0;              // reported B_w = true * (1 + error)
+
   Trajectory trajectory;
+  std::optional<OccupancyGrid> map;
+  std::optional<LaserModel> laser;
 };
 
 // The built-in scenario `demo` and the tests run: seed 000's setup (six Txs at z_T = 2.011 m,
 // three Rxs on a 0.19 m circle, sigma_dd = 0.01 m, k_v = 4e-4 m, 0.34 m/s, 100 Hz odometry,
-// 200 ms slots) on a 2 m x 1.2 m stadium loop under a 3 x 2 beacon grid.
+// 200 ms slots) on a 2 m x 1.2 m stadium loop under a 3 x 2 beacon grid
+// (examples/scenarios/default.yaml describes the same world).
 Scenario default_scenario();
 
 }  // namespace beaconloc::sim

@@ -1,13 +1,15 @@
 #include "sim_source.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "beaconloc/core/speed_of_sound.hpp"
 
 namespace beaconloc::sim {
 
 double pulse_arrival_s(const Trajectory& trajectory, const Eigen::Vector2d& receiver_base_m,
-                       double receiver_z_m, const Eigen::Vector3d& beacon_map_m, double fire_s, double c) {
+                       double receiver_z_m, const Eigen::Vector3d& beacon_map_m, double fire_s,
+                       double c) {
   double arrival_s = fire_s;
   for (int i = 0; i < 6; ++i) {
     const Eigen::Vector2d rx = transform_point(trajectory.pose_at(arrival_s), receiver_base_m);
@@ -19,11 +21,21 @@ double pulse_arrival_s(const Trajectory& trajectory, const Eigen::Vector2d& rece
   return arrival_s;
 }
 
+bool hears(const Scenario& s, const Eigen::Vector3d& beacon, const Eigen::Vector3d& receiver) {
+  const Eigen::Vector3d d = receiver - beacon;
+  const double range = d.norm();
+  if (range < s.min_range_m || range > s.max_range_m) return false;
+  if (range < 1e-9) return true;
+  const double cos_off_axis = -d.z() / range;  // angle to the beacon's downward axis
+  return cos_off_axis >= std::cos(s.beam_half_angle_rad) - 1e-12;
+}
+
 SimSource::SimSource(Scenario scenario, std::uint64_t seed)
     : scenario_(std::move(scenario)),
       rng_(seed),
       next_odometry_ns_(scenario_.odometry_period_ns),
-      next_fire_ns_(scenario_.first_slot_ns) {}
+      next_fire_ns_(scenario_.first_slot_ns),
+      next_scan_ns_(scenario_.laser ? scenario_.laser->period_ns : std::numeric_limits<StampNs>::max()) {}
 
 void SimSource::fire(StampNs fire_ns) {
   if (scenario_.firing_order.empty()) return;
@@ -36,55 +48,89 @@ void SimSource::fire(StampNs fire_ns) {
   if (!beacon) return;
   const double c = speed_of_sound_mps(scenario_.temperature_c);
   const double fire_s = ns_to_s(fire_ns);
+  const bool announces_id =
+      scenario_.identified || (scenario_.marked_beacon_id && *scenario_.marked_beacon_id == beacon_id);
   for (std::uint32_t rx = 0; rx < scenario_.receivers.size(); ++rx) {
+    const Eigen::Vector2d& rx_base = scenario_.receivers.receivers_base_m[rx];
+    const double rx_z = scenario_.receivers.receiver_height_m;
     const double arrival_s =
-        pulse_arrival_s(scenario_.trajectory, scenario_.receivers.receivers_base_m[rx],
-                        scenario_.receivers.receiver_height_m, beacon->position_map_m, fire_s, c);
-    const double true_tof_s = arrival_s - fire_s;
-    if (true_tof_s * c > scenario_.max_range_m) continue;  // out of earshot
-    SimEvent e;
-    e.kind = SimEvent::Kind::kTof;
-    e.tof.beacon_id = beacon_id;
+        pulse_arrival_s(scenario_.trajectory, rx_base, rx_z, beacon->position_map_m, fire_s, c);
+    const Eigen::Vector2d rx_map = transform_point(scenario_.trajectory.pose_at(arrival_s), rx_base);
+    if (!hears(scenario_, beacon->position_map_m, {rx_map.x(), rx_map.y(), rx_z})) continue;
+    SourceEvent e;
+    e.kind = SourceEvent::Kind::kTof;
+    e.true_beacon_id = beacon_id;
+    e.tof.beacon_id = announces_id ? beacon_id : kBeaconUnidentified;
     e.tof.receiver_id = rx;
     e.tof.fire_stamp_ns = fire_ns;
-    e.tof.tof_s = true_tof_s + scenario_.range_sigma_m / c * unit_normal_(rng_);
-    e.tof.beacon_temperature_c = scenario_.temperature_c;
+    e.tof.tof_s = arrival_s - fire_s + scenario_.range_sigma_m / c * normal() + scenario_.tof_sigma_s * normal();
+    if (scenario_.echo.probability > 0.0 && uniform() < scenario_.echo.probability) {
+      const auto& echo = scenario_.echo;
+      e.tof.tof_s += (echo.min_extra_path_m + uniform() * (echo.max_extra_path_m - echo.min_extra_path_m)) / c;
+      e.tof_is_echo = true;
+    }
+    e.tof.beacon_temperature_c = scenario_.reported_temperature_c.value_or(scenario_.temperature_c);
     e.tof.sequence_number = tof_sequence_++;
     e.stamp_ns = fire_ns + s_to_ns(e.tof.tof_s);
     pending_tofs_.push(e);
   }
 }
 
-SimEvent SimSource::odometry_at(StampNs stamp_ns) {
+SourceEvent SimSource::odometry_at(StampNs stamp_ns) {
   const double dt_s = ns_to_s(scenario_.odometry_period_ns);
   const double t1 = ns_to_s(stamp_ns);
   double v = 0.0, w = 0.0;
   scenario_.trajectory.mean_velocity(t1 - dt_s, t1, v, w);
   const double half_track = scenario_.wheel_base_m / 2.0;
-  const double true_right = v + w * half_track, true_left = v - w * half_track;
-  // Seed 000: sigma_v^2 = k_v |v| / dT for each wheel.
+  // Systematic errors (wheel radii) scale what the encoders report; then the random error of
+  // seed 000, sigma_v^2 = k_v |v| / dT for each wheel.
+  const double right = (v + w * half_track) * (1.0 + scenario_.wheel_radius_error_right);
+  const double left = (v - w * half_track) * (1.0 + scenario_.wheel_radius_error_left);
   auto noisy = [&](double wheel_mps) {
-    return wheel_mps + std::sqrt(scenario_.odometry_k_v_m * std::abs(wheel_mps) / dt_s) * unit_normal_(rng_);
+    return wheel_mps + std::sqrt(scenario_.odometry_k_v_m * std::abs(wheel_mps) / dt_s) * normal();
   };
-  SimEvent e;
-  e.kind = SimEvent::Kind::kOdometry;
+  SourceEvent e;
+  e.kind = SourceEvent::Kind::kOdometry;
   e.stamp_ns = stamp_ns;
   e.odometry.stamp_ns = stamp_ns;
-  e.odometry.wheel_velocity_right_mps = noisy(true_right);
-  e.odometry.wheel_velocity_left_mps = noisy(true_left);
-  e.odometry.wheel_base_m = scenario_.wheel_base_m;
+  e.odometry.wheel_velocity_right_mps = noisy(right);
+  e.odometry.wheel_velocity_left_mps = noisy(left);
+  e.odometry.wheel_base_m = scenario_.wheel_base_m * (1.0 + scenario_.wheel_base_error);
   // The robot reports the noise model evaluated at what it measured (it cannot know the truth).
   e.odometry.wheel_velocity_covariance.diagonal()
       << scenario_.odometry_k_v_m * std::abs(e.odometry.wheel_velocity_right_mps) / dt_s,
       scenario_.odometry_k_v_m * std::abs(e.odometry.wheel_velocity_left_mps) / dt_s;
+  e.has_truth = true;
   e.truth_map_base = scenario_.trajectory.pose_at(t1);
   return e;
 }
 
-void SimSource::advance(StampNs until_ns, std::vector<SimEvent>& out) {
+SourceEvent SimSource::scan_at(StampNs stamp_ns) {
+  const LaserModel& laser = *scenario_.laser;
+  const Pose2 sensor = compose(scenario_.trajectory.pose_at(ns_to_s(stamp_ns)), laser.mount_base);
+  SourceEvent e;
+  e.kind = SourceEvent::Kind::kLaserScan;
+  e.stamp_ns = stamp_ns;
+  e.scan.stamp_ns = stamp_ns;
+  const double increment = laser.beams > 1 ? laser.fov_rad / (laser.beams - 1) : 0.0;
+  e.scan.angle_min_rad = static_cast<float>(-laser.fov_rad / 2.0);
+  e.scan.angle_increment_rad = static_cast<float>(increment);
+  e.scan.range_min_m = 0.0f;
+  e.scan.range_max_m = static_cast<float>(laser.max_range_m);
+  for (int i = 0; i < laser.beams; ++i) {
+    const double angle = sensor.z() - laser.fov_rad / 2.0 + i * increment;
+    const auto hit = scenario_.map->cast_ray(sensor.head<2>(), angle, laser.max_range_m);
+    const double noise = normal();  // drawn for every beam: the stream does not depend on hits
+    e.scan.ranges_m.push_back(hit ? static_cast<float>(std::max(0.0, *hit + laser.range_sigma_m * noise))
+                                  : std::numeric_limits<float>::infinity());
+  }
+  return e;
+}
+
+void SimSource::advance(StampNs until_ns, std::vector<SourceEvent>& out) {
   for (;;) {
     const StampNs next_tof = pending_tofs_.empty() ? until_ns + 1 : pending_tofs_.top().stamp_ns;
-    const StampNs next = std::min({next_odometry_ns_, next_fire_ns_, next_tof});
+    const StampNs next = std::min({next_odometry_ns_, next_fire_ns_, next_tof, next_scan_ns_});
     if (next > until_ns) return;
     if (next == next_fire_ns_) {
       fire(next_fire_ns_);
@@ -92,9 +138,12 @@ void SimSource::advance(StampNs until_ns, std::vector<SimEvent>& out) {
     } else if (next == next_tof) {
       out.push_back(pending_tofs_.top());
       pending_tofs_.pop();
-    } else {
+    } else if (next == next_odometry_ns_) {
       out.push_back(odometry_at(next_odometry_ns_));
       next_odometry_ns_ += scenario_.odometry_period_ns;
+    } else {
+      out.push_back(scan_at(next_scan_ns_));
+      next_scan_ns_ += scenario_.laser->period_ns;
     }
   }
 }

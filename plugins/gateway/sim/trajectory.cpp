@@ -1,6 +1,8 @@
 #include "trajectory.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace beaconloc::sim {
 
@@ -13,6 +15,30 @@ Pose2 integrate_arc(const Pose2& from, double v, double w, double t) {
   const double yaw1 = yaw + w * t;
   return {from.x() + r * (std::sin(yaw1) - std::sin(yaw)), from.y() - r * (std::cos(yaw1) - std::cos(yaw)),
           wrap_angle_rad(yaw1)};
+}
+
+Trajectory Trajectory::from_waypoints(const std::vector<Eigen::Vector2d>& waypoints, double speed,
+                                      double turn_rate) {
+  if (waypoints.size() < 2) throw std::invalid_argument("a waypoint path needs at least two waypoints");
+  if (!(speed > 0.0) || !(turn_rate > 0.0)) {
+    throw std::invalid_argument("a waypoint path needs speed_mps > 0 and turn_rate_radps > 0");
+  }
+  std::vector<VelocitySegment> segments;
+  const Eigen::Vector2d first_leg = waypoints[1] - waypoints[0];
+  double heading = std::atan2(first_leg.y(), first_leg.x());
+  const Pose2 start(waypoints[0].x(), waypoints[0].y(), heading);
+  for (std::size_t i = 0; i + 1 < waypoints.size(); ++i) {
+    const Eigen::Vector2d leg = waypoints[i + 1] - waypoints[i];
+    if (leg.norm() < 1e-9) throw std::invalid_argument("waypoints " + std::to_string(i) + " and " +
+                                                       std::to_string(i + 1) + " coincide");
+    const double turn = wrap_angle_rad(std::atan2(leg.y(), leg.x()) - heading);
+    if (std::abs(turn) > 1e-12) {
+      segments.push_back({std::abs(turn) / turn_rate, 0.0, turn > 0 ? turn_rate : -turn_rate});
+    }
+    segments.push_back({leg.norm() / speed, speed, 0.0});
+    heading += turn;
+  }
+  return Trajectory(start, std::move(segments), false);
 }
 
 Trajectory::Trajectory(const Pose2& start, std::vector<VelocitySegment> segments, bool loop)

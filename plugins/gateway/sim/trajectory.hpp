@@ -18,10 +18,17 @@ class Trajectory {
   Trajectory() = default;
   Trajectory(const Pose2& start_map_base, std::vector<VelocitySegment> segments, bool loop);
 
+  // Straight legs between waypoints at speed_mps, turning in place at each waypoint at
+  // turn_rate_radps; starts at the first waypoint facing the second. Throws on fewer than two
+  // waypoints, repeated waypoints or non-positive rates.
+  static Trajectory from_waypoints(const std::vector<Eigen::Vector2d>& waypoints_m, double speed_mps,
+                                   double turn_rate_radps);
+
   Pose2 pose_at(double t_s) const;
   // Mean linear and angular velocity over [t0_s, t1_s] (exact integral of the segments).
   void mean_velocity(double t0_s, double t1_s, double& linear_mps, double& angular_radps) const;
-  double period_s() const { return period_s_; }
+  double period_s() const { return period_s_; }  // one lap, or the whole path
+  bool loops() const { return loop_; }
 
  private:
   // Distance and heading change travelled from 0 to t_s.

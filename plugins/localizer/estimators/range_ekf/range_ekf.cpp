@@ -19,6 +19,9 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
   p.reinitialize_after_gated =
       static_cast<int>(c.parameter("reinitialize_after_gated", p.reinitialize_after_gated));
   p.max_range_age_s = c.parameter("max_range_age_s", p.max_range_age_s);
+  p.init_max_position_sigma_m = c.parameter("init_max_position_sigma_m", p.init_max_position_sigma_m);
+  p.init_max_yaw_sigma_rad = c.parameter("init_max_yaw_sigma_rad", p.init_max_yaw_sigma_rad);
+  p.init_retry_interval_s = c.parameter("init_retry_interval_s", p.init_retry_interval_s);
   return p;
 }
 
@@ -118,9 +121,13 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r) {
 }
 
 void RangeEkf::try_initialize() {
+  // The multi-start solve costs ~1 ms: not more often than init_retry_interval_s of data time.
+  const StampNs now_ns = window_.back().range.stamp_ns;
+  if (last_init_attempt_ns_ && now_ns - *last_init_attempt_ns_ < s_to_ns(params_.init_retry_interval_s)) return;
   std::set<std::uint32_t> beacons;
   for (const auto& b : window_) beacons.insert(b.range.beacon_id);
   if (static_cast<int>(beacons.size()) < params_.init_min_beacons) return;
+  last_init_attempt_ns_ = now_ns;
 
   std::vector<RangeObservation> observations;
   for (const auto& b : window_) {

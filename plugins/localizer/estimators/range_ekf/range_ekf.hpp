@@ -22,6 +22,7 @@ struct RangeEkfParameters {
   double wheel_velocity_variance_floor_m2ps2 = 1e-6;
   int reinitialize_after_gated = 15;  // 5 slots x 3 receivers refused in a row: lost
   double max_range_age_s = 0.6;       // ranges older than the newest odometry by more: stale
+  double init_retry_interval_s = 0.5; // data time between two attempts at a global fix
 
   static RangeEkfParameters from(const EstimatorConfig& config);
 };
@@ -55,6 +56,7 @@ class RangeEkf final : public Estimator {
   Pose2 odom_pose_ = Pose2::Zero();  // dead-reckoned, odometry frame
   std::deque<BufferedRange> window_;
   int consecutive_gated_ = 0;
+  std::optional<StampNs> last_init_attempt_ns_;
 };
 
 }  // namespace beaconloc

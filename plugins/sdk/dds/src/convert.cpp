@@ -59,6 +59,29 @@ RangeMeasurement from_msg(const msg::BeaconRange& m) {
   return r;
 }
 
+LaserScanSample from_msg(const msg::LaserScan& m) {
+  LaserScanSample s;
+  s.stamp_ns = m.stamp_ns();
+  s.angle_min_rad = m.angle_min_rad();
+  s.angle_increment_rad = m.angle_increment_rad();
+  s.range_min_m = m.range_min_m();
+  s.range_max_m = m.range_max_m();
+  s.ranges_m = m.ranges_m();
+  return s;
+}
+
+msg::LaserScan to_msg(const std::string& robot_id, const LaserScanSample& s) {
+  msg::LaserScan m;
+  m.robot_id(robot_id);
+  m.stamp_ns(s.stamp_ns);
+  m.angle_min_rad(s.angle_min_rad);
+  m.angle_increment_rad(s.angle_increment_rad);
+  m.range_min_m(s.range_min_m);
+  m.range_max_m(s.range_max_m);
+  m.ranges_m(s.ranges_m);
+  return m;
+}
+
 BeaconMap from_msg(const msg::BeaconMap& m) {
   std::vector<Beacon> beacons;
   for (const auto& b : m.beacons()) {

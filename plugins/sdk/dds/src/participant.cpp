@@ -4,6 +4,7 @@
 #include <fstream>
 #include <mutex>
 #include <string_view>
+#include <thread>
 
 namespace beaconloc::embedded {
 extern const std::string_view kLoopbackProfilesXml;
@@ -32,6 +33,21 @@ void load_qos_profiles(const std::vector<std::string>& extra_files) {
     if (factory->load_XML_profiles_file(file) != ReturnCode_t::RETCODE_OK) {
       throw DdsError("QoS file '" + file + "' is not a valid Fast DDS profiles file");
     }
+  }
+}
+
+bool wait_for_matched_readers(const std::vector<DataWriter*>& writers, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    bool all = true;
+    for (auto* w : writers) {
+      PublicationMatchedStatus status;
+      w->get_publication_matched_status(status);
+      all = all && status.current_count > 0;
+    }
+    if (all) return true;
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
 }
 

@@ -41,3 +41,20 @@ struct RawTofSample {
 };
 
 }  // namespace beaconloc
+
+#include <vector>
+
+namespace beaconloc {
+
+// DDS-free form of the LaserScan topic. Beam i points at angle_min_rad + i * angle_increment_rad
+// in the robot frame; a range outside [range_min_m, range_max_m] (e.g. +inf) is no return.
+struct LaserScanSample {
+  StampNs stamp_ns = 0;
+  float angle_min_rad = 0.0f;
+  float angle_increment_rad = 0.0f;
+  float range_min_m = 0.0f;
+  float range_max_m = 0.0f;
+  std::vector<float> ranges_m;
+};
+
+}  // namespace beaconloc

@@ -21,6 +21,10 @@ class RejectionCounter {
     return n;
   }
   const std::map<std::string, std::uint64_t>& rejected_by_reason() const { return rejected_; }
+  // Adds another counter's rejections under prefix + reason (its accepted count is not added).
+  void add_rejections(const RejectionCounter& other, const std::string& prefix) {
+    for (const auto& [reason, count] : other.rejected_) rejected_[prefix + reason] += count;
+  }
 
  private:
   std::uint64_t accepted_ = 0;

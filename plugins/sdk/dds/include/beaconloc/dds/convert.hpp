@@ -20,6 +20,9 @@ msg::Odometry to_msg(const std::string& robot_id, const OdometrySample& s, std::
 
 RangeMeasurement from_msg(const msg::BeaconRange& m);
 
+LaserScanSample from_msg(const msg::LaserScan& m);
+msg::LaserScan to_msg(const std::string& robot_id, const LaserScanSample& s);
+
 BeaconMap from_msg(const msg::BeaconMap& m);
 msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id);
 

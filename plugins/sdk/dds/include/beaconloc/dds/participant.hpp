@@ -2,6 +2,7 @@
 // A DomainParticipant with its publisher and subscriber, created from the XML profiles. Owns and
 // deletes every entity it creates. Thin: no logic beyond creating entities with named QoS.
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -60,6 +61,10 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
   std::function<void(const Msg&)> on_sample_;
   std::atomic<std::uint64_t>* deadline_misses_;
 };
+
+// Waits until every writer has at least one matched reader; false on timeout.
+bool wait_for_matched_readers(const std::vector<eprosima::fastdds::dds::DataWriter*>& writers,
+                              std::chrono::milliseconds timeout);
 
 class Participant {
  public:

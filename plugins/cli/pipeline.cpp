@@ -1,0 +1,421 @@
+#include "pipeline.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "beaconloc/dds/stop_signal.hpp"
+#include "decoder_participant.hpp"
+#include "diagnostics_recorder.hpp"
+#include "localizer_participant.hpp"
+#include "pose_recorder.hpp"
+#include "sim/scenario_yaml.hpp"
+#include "sim/sim_source.hpp"
+#include "svg_plot.hpp"
+
+extern char** environ;
+
+namespace beaconloc::cli {
+namespace {
+
+using namespace std::chrono_literals;
+
+// Samples a participant may still have to take before the gateway writes more: well inside the
+// reader histories (examples/qos/topics.xml: odometry 50, TOF and ranges 16), so a run in one
+// process as fast as the machine goes loses nothing.
+constexpr std::uint64_t kMaxOdometryLead = 25;
+constexpr std::uint64_t kMaxTofLead = 8;
+
+class ChildProcess {
+ public:
+  ChildProcess(const std::string& exe, const std::vector<std::string>& args, const std::string& log) : log_(log) {
+    std::vector<std::string> argv{exe};
+    argv.insert(argv.end(), args.begin(), args.end());
+    std::vector<char*> c_argv;
+    for (auto& a : argv) c_argv.push_back(a.data());
+    c_argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+    const int rc = posix_spawn(&pid_, exe.c_str(), &actions, nullptr, c_argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0) throw std::runtime_error("cannot start " + exe);
+  }
+  ~ChildProcess() {
+    if (pid_ > 0 && !done_) {
+      ::kill(pid_, SIGTERM);
+      wait(10s);
+      if (!done_) {
+        ::kill(pid_, SIGKILL);
+        wait(10s);
+      }
+    }
+  }
+  // Exit code, or -1 while running after the timeout.
+  int wait(std::chrono::milliseconds timeout) {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (!done_) {
+      int status = 0;
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        done_ = true;
+        code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        break;
+      }
+      if (std::chrono::steady_clock::now() > end) return -1;
+      std::this_thread::sleep_for(20ms);
+    }
+    return code_;
+  }
+  void terminate() {
+    if (!done_) ::kill(pid_, SIGTERM);
+  }
+  bool done() {
+    wait(0ms);
+    return done_;
+  }
+  const std::string& log() const { return log_; }
+
+ private:
+  pid_t pid_ = -1;
+  bool done_ = false;
+  int code_ = -1;
+  std::string log_;
+};
+
+std::string join_receivers(const ReceiverArray& receivers) {
+  std::ostringstream s;
+  s << std::setprecision(10);
+  for (std::size_t i = 0; i < receivers.size(); ++i) {
+    s << (i ? "," : "") << receivers.receivers_base_m[i].x() << ':' << receivers.receivers_base_m[i].y();
+  }
+  return s.str();
+}
+
+void print_pose_line(double t_s, const PoseRecorder& recorder) {
+  const auto poses = recorder.poses();
+  if (poses.empty()) {
+    std::printf("t=%6.1f s  no pose yet (initializing from beacons)\n", t_s);
+  } else {
+    const auto& p = poses.back().row.estimate;
+    std::printf("t=%6.1f s  pose x %.3f m  y %.3f m  yaw %6.1f deg  %s\n", t_s, p.pose_map_base.x(),
+                p.pose_map_base.y(), p.pose_map_base.z() * 180.0 / M_PI, to_string(p.status));
+  }
+  std::fflush(stdout);
+}
+
+// Scores and writes the outputs shared by both modes.
+PipelineResult finish(const PipelineOptions& o, const LoadedSource& source, const BeaconMap& beacons,
+                      const std::vector<RecordedPose>& poses, const TruthTrack& truth, const std::string& diagnostics) {
+  PipelineResult r;
+  EvaluationOptions eval;
+  if (!poses.empty() && o.score_from_ns > 0) eval.score_from_ns = poses.front().row.estimate.stamp_ns + o.score_from_ns;
+  const PoseRunSummary s = summarize(poses, truth, eval);
+  r.poses = s.poses;
+  r.pose_rate_hz = s.pose_rate_hz;
+  r.metrics = s.metrics;
+  r.diagnostics = diagnostics;
+  if (!o.out_dir.empty()) {
+    const auto rows = rows_of(poses);
+    write_estimates_csv(o.out_dir + "/estimate.csv", rows);
+    write_beacons_csv(o.out_dir + "/beacons.csv", beacons);
+    write_metrics_json(o.out_dir + "/metrics.json", r.metrics, o.localizer.estimator, source.label);
+    const std::string title = source.label + ", " + o.localizer.estimator;
+    write_trajectory_svg(o.out_dir + "/trajectory.svg", title, truth, rows, beacons,
+                         source.scenario ? source.scenario->map : std::nullopt);
+    write_error_svg(o.out_dir + "/error.svg", title, error_series(truth, rows, eval));
+  }
+  return r;
+}
+
+PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source) {
+  std::mutex truth_mutex;
+  TruthTrack truth;
+  const BeaconMap beacons = source.source->beacon_map();
+  const EstimatorConfig config = o.localizer.config(source.source->receivers());
+  LocalizerParticipant localizer(o.dds, LocalizerCore(o.localizer.estimator, config, o.localizer.robot));
+  DecoderParticipant decoder(o.dds, o.decoder);
+  PoseRecorder recorder(o.dds);
+  DiagnosticsRecorder diagnostics(o.dds);
+  std::unique_ptr<GatewayParticipant> gateway;
+  std::uint64_t stalls = 0;
+  auto throttle = [&] {
+    // Hold the gateway back while the decoder or the localizer lags (speed 0: as fast as they go).
+    const auto give_up = std::chrono::steady_clock::now() + 2s;
+    const auto& written = gateway->progress();
+    while (written.odometry_written.load() > localizer.odometry_processed() + kMaxOdometryLead ||
+           written.tofs_written.load() > decoder.tofs_processed() + kMaxTofLead ||
+           decoder.ranges_written() > localizer.ranges_processed() + kMaxTofLead) {
+      if (std::chrono::steady_clock::now() > give_up) {
+        ++stalls;  // a sample was lost on the way: do not wait for it forever
+        return;
+      }
+      std::this_thread::sleep_for(50us);
+    }
+  };
+  LoadedSource described{source.choice, source.seed, nullptr, source.scenario, source.label};
+  gateway = std::make_unique<GatewayParticipant>(
+      o.dds, o.gateway, std::move(source.source),
+      [&](StampNs stamp, const Pose2& pose, bool has_yaw) {
+        std::lock_guard<std::mutex> lock(truth_mutex);
+        truth.add(stamp, pose, has_yaw);
+      },
+      o.gateway.speed == 0.0 ? GatewayParticipant::Throttle(throttle) : GatewayParticipant::Throttle());
+  if (!gateway->wait_for_readers(5s) || !decoder.wait_for_readers(5s)) {
+    throw std::runtime_error("the participants did not discover each other within 5 s");
+  }
+  gateway->start();
+  const auto start = std::chrono::steady_clock::now();
+  double next_pose_s = 1.0, next_progress_s = 2.0;
+  while (!gateway->finished() && !dds::wait_for_stop(50ms)) {
+    if (o.print_poses && gateway->elapsed_s() >= next_pose_s) {
+      print_pose_line(gateway->elapsed_s(), recorder);
+      next_pose_s += 1.0;
+    }
+    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (o.print_progress && wall_s >= next_progress_s) {
+      std::printf("run: %.1f of %.1f s of data (%.0f%%), %zu poses\n", gateway->elapsed_s(), gateway->total_s(),
+                  100.0 * gateway->elapsed_s() / std::max(gateway->total_s(), 1e-9), recorder.count());
+      std::fflush(stdout);
+      next_progress_s += 2.0;
+    }
+  }
+  gateway->stop();
+  gateway->rethrow_failure();
+  // Let the last samples through the pipeline.
+  const auto drain_until = std::chrono::steady_clock::now() + 3s;
+  while (std::chrono::steady_clock::now() < drain_until &&
+         (gateway->progress().odometry_written.load() > localizer.odometry_processed() ||
+          decoder.ranges_written() > localizer.ranges_processed())) {
+    std::this_thread::sleep_for(10ms);
+  }
+  std::this_thread::sleep_for(100ms);
+  if (stalls) {
+    std::printf("run: the gateway waited for a lost sample %llu time(s)\n", static_cast<unsigned long long>(stalls));
+  }
+  gateway->publish_diagnostics();
+  decoder.publish_diagnostics();
+  localizer.publish_diagnostics();
+  std::this_thread::sleep_for(200ms);
+  std::ostringstream diag;
+  print_diagnostics(diagnostics.latest(), diag);
+  std::lock_guard<std::mutex> lock(truth_mutex);
+  return finish(o, described, beacons, recorder.poses(), truth, diag.str());
+}
+
+std::vector<std::string> dds_arguments(const dds::DdsOptions& d) {
+  std::vector<std::string> a{"--domain", std::to_string(d.domain_id), "--participant-profile", d.participant_profile};
+  for (const auto& f : d.extra_qos_files) {
+    a.push_back("--qos");
+    a.push_back(f);
+  }
+  return a;
+}
+
+std::string number(double v) {
+  std::ostringstream s;
+  s << std::setprecision(17) << v;
+  return s.str();
+}
+
+PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, const std::string& exe) {
+  if (o.out_dir.empty()) throw std::invalid_argument("--processes needs --out (the participants' logs go there)");
+  if (!(o.gateway.speed > 0.0)) {
+    throw std::invalid_argument("--processes needs --speed > 0: separate processes cannot hold the gateway back");
+  }
+  const BeaconMap beacons = source.source->beacon_map();
+  const ReceiverArray receivers = source.source->receivers();
+  PoseRecorder recorder(o.dds);
+  DiagnosticsRecorder diagnostics(o.dds);
+
+  auto localizer_args = std::vector<std::string>{"localizer"};
+  for (const auto& a : dds_arguments(o.dds)) localizer_args.push_back(a);
+  for (const auto& a : o.localizer.arguments(receivers)) localizer_args.push_back(a);
+  auto decoder_args = std::vector<std::string>{"decoder"};
+  for (const auto& a : dds_arguments(o.dds)) decoder_args.push_back(a);
+  for (const auto& a : std::vector<std::string>{
+           "--min-range-m", number(o.decoder.min_range_m), "--max-range-m", number(o.decoder.max_range_m),
+           "--range-sigma-m", number(o.decoder.range_sigma_m), "--range-scale", number(o.decoder.range_scale),
+           "--max-age-ms", number(static_cast<double>(o.decoder.max_age_ns) / 1e6)}) {
+    decoder_args.push_back(a);
+  }
+  auto gateway_args = std::vector<std::string>{"gateway"};
+  for (const auto& a : dds_arguments(o.dds)) gateway_args.push_back(a);
+  for (const auto& a : std::vector<std::string>{"--robot", o.gateway.robot_id, "--speed", number(o.gateway.speed),
+                                                "--seed", std::to_string(o.gateway.seed), "--duration-s",
+                                                number(o.gateway.duration_s), "--truth-out", o.out_dir + "/truth.csv"}) {
+    gateway_args.push_back(a);
+  }
+  if (!source.choice.replay_dir.empty()) {
+    for (const auto& a : std::vector<std::string>{
+             "--replay", source.choice.replay_dir, "--replay-wheel-base-m", number(source.choice.replay.wheel_base_m),
+             "--replay-odometry-k-v", number(source.choice.replay.odometry_k_v_m)}) {
+      gateway_args.push_back(a);
+    }
+  } else if (!source.choice.scenario_file.empty()) {
+    gateway_args.push_back("--scenario");
+    gateway_args.push_back(source.choice.scenario_file);
+  }
+
+  ChildProcess localizer(exe, localizer_args, o.out_dir + "/localizer.log");
+  ChildProcess decoder(exe, decoder_args, o.out_dir + "/decoder.log");
+  std::this_thread::sleep_for(1s);  // their readers exist before the gateway writes
+  ChildProcess gateway(exe, gateway_args, o.out_dir + "/gateway.log");
+  const auto start = std::chrono::steady_clock::now();
+  const double total_s = o.gateway.duration_s > 0.0 ? o.gateway.duration_s
+                                                     : ns_to_s(source.source->last_stamp_ns() - source.source->first_stamp_ns());
+  double next_progress_s = 2.0;
+  while (!gateway.done() && !dds::wait_for_stop(100ms)) {
+    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (o.print_progress && wall_s >= next_progress_s) {
+      std::printf("run: ~%.0f of %.1f s of data, %zu poses\n", std::min(wall_s * o.gateway.speed, total_s), total_s,
+                  recorder.count());
+      std::fflush(stdout);
+      next_progress_s += 2.0;
+    }
+  }
+  const int gateway_code = gateway.wait(dds::stop_requested() ? 0ms : 10s);
+  std::this_thread::sleep_for(500ms);
+  decoder.terminate();
+  localizer.terminate();
+  const int decoder_code = decoder.wait(15s), localizer_code = localizer.wait(15s);
+  if (gateway_code != 0 || decoder_code != 0 || localizer_code != 0) {
+    throw std::runtime_error("a participant failed (exit codes gateway " + std::to_string(gateway_code) + ", decoder " +
+                             std::to_string(decoder_code) + ", localizer " + std::to_string(localizer_code) +
+                             "); logs in " + o.out_dir);
+  }
+  std::ostringstream diag;
+  print_diagnostics(diagnostics.latest(), diag);
+  return finish(o, source, beacons, recorder.poses(), load_truth_csv(o.out_dir + "/truth.csv"), diag.str());
+}
+
+std::vector<std::pair<std::string, std::string>> split_pairs(const std::string& text, char outer, char inner) {
+  std::vector<std::pair<std::string, std::string>> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, outer)) {
+    const auto at = item.find(inner);
+    out.emplace_back(item.substr(0, at), at == std::string::npos ? std::string() : item.substr(at + 1));
+  }
+  return out;
+}
+
+double parse_double(const std::string& text, const std::string& what) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    if (used != text.size() || !std::isfinite(v)) throw std::invalid_argument(text);
+    return v;
+  } catch (const std::exception&) {
+    throw std::invalid_argument(what + ": '" + text + "' is not a number");
+  }
+}
+
+}  // namespace
+
+LoadedSource load_source(const SourceChoice& choice, std::optional<std::uint64_t> seed) {
+  LoadedSource out;
+  out.choice = choice;
+  if (!choice.replay_dir.empty()) {
+    auto replay = std::make_unique<ReplaySource>(choice.replay_dir, choice.replay);
+    for (const auto& problem : replay->load_problems()) std::fprintf(stderr, "replay: refused %s\n", problem.c_str());
+    for (const auto& note : replay->load_notes()) std::fprintf(stderr, "replay: note: %s\n", note.c_str());
+    out.label = "replay " + std::filesystem::path(choice.replay_dir).filename().string();
+    if (out.label == "replay ") out.label = "replay " + choice.replay_dir;
+    out.seed = seed.value_or(1);
+    out.source = std::move(replay);
+    return out;
+  }
+  sim::Scenario scenario =
+      choice.scenario_file.empty() ? sim::default_scenario() : sim::load_scenario_file(choice.scenario_file);
+  out.seed = seed.value_or(scenario.seed);
+  out.label = "scenario " + scenario.name;
+  out.scenario = scenario;
+  out.source = std::make_unique<sim::SimSource>(scenario, out.seed);
+  return out;
+}
+
+EstimatorConfig LocalizerSettings::config(const std::optional<ReceiverArray>& fallback) const {
+  EstimatorConfig c;
+  if (!receivers.empty()) {
+    for (const auto& [x, y] : split_pairs(receivers, ',', ':')) {
+      c.receivers.receivers_base_m.emplace_back(parse_double(x, "--receivers"), parse_double(y, "--receivers"));
+    }
+    c.receivers.receiver_height_m = receiver_height_m;
+  } else if (fallback) {
+    c.receivers = *fallback;
+  } else {
+    c.receivers = ReceiverArray::on_circle(receiver_radius_m, receiver_count);
+    c.receivers.receiver_height_m = receiver_height_m;
+  }
+  for (const auto& p : parameters) {
+    const auto eq = p.find('=');
+    if (eq == std::string::npos || eq == 0) throw std::invalid_argument("--param '" + p + "' is not NAME=VALUE");
+    c.parameters[p.substr(0, eq)] = parse_double(p.substr(eq + 1), "--param '" + p + "'");
+  }
+  return c;
+}
+
+std::vector<std::string> LocalizerSettings::arguments(const std::optional<ReceiverArray>& fallback) const {
+  const EstimatorConfig c = config(fallback);
+  std::vector<std::string> a{"--estimator", estimator, "--receivers", join_receivers(c.receivers),
+                             "--receiver-height-m", number(c.receivers.receiver_height_m)};
+  if (!robot.empty()) {
+    a.push_back("--robot");
+    a.push_back(robot);
+  }
+  for (const auto& p : parameters) {
+    a.push_back("--param");
+    a.push_back(p);
+  }
+  return a;
+}
+
+PipelineResult run_pipeline(const PipelineOptions& options, LoadedSource source, const std::string& self_exe) {
+  if (!options.out_dir.empty()) std::filesystem::create_directories(options.out_dir);
+  return options.processes ? run_in_processes(options, std::move(source), self_exe)
+                           : run_in_one_process(options, std::move(source));
+}
+
+Metrics evaluate_files(const std::string& truth_csv, const std::string& estimate_csv, const std::string& out_dir,
+                       const std::string& beacons_csv, double max_truth_gap_s) {
+  const TruthTrack truth = load_truth_csv(truth_csv);
+  const auto rows = load_estimates_csv(estimate_csv);
+  const BeaconMap beacons = beacons_csv.empty() ? BeaconMap() : load_beacons_csv(beacons_csv);
+  EvaluationOptions eval;
+  eval.max_truth_gap_ns = s_to_ns(max_truth_gap_s);
+  const Metrics m = evaluate(truth, rows, eval);
+  std::filesystem::create_directories(out_dir);
+  const std::string estimator = rows.empty() ? std::string() : rows.front().estimator;
+  write_metrics_json(out_dir + "/metrics.json", m, estimator, estimate_csv);
+  const std::string title = std::filesystem::path(estimate_csv).filename().string() + ", " + estimator;
+  write_trajectory_svg(out_dir + "/trajectory.svg", title, truth, rows, beacons);
+  write_error_svg(out_dir + "/error.svg", title, error_series(truth, rows, eval));
+  return m;
+}
+
+std::string format_metrics(const Metrics& m) {
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "against ground truth (%zu poses): position RMS %.3f m, mean %.3f m, max %.3f m; heading RMS %s; "
+                "E_S mean %s; NEES in 95%% band %.2f",
+                m.samples, m.position_rms_m, m.position_mean_m, m.position_max_m,
+                m.heading_rms_deg ? (std::to_string(*m.heading_rms_deg).substr(0, 5) + " deg").c_str() : "n/a",
+                m.significant_points_mean_m ? (std::to_string(*m.significant_points_mean_m).substr(0, 5) + " m").c_str()
+                                            : "n/a",
+                m.nees_in_band_fraction);
+  return line;
+}
+
+}  // namespace beaconloc::cli

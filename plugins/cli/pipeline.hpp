@@ -1,0 +1,84 @@
+#pragma once
+// Running the whole pipeline (gateway, decoder, localizer) on a source and scoring it: in one
+// process (demo, run) or one process per participant (run --processes).
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/estimator.hpp"
+#include "beaconloc/dds/participant.hpp"
+#include "evaluation.hpp"
+#include "gateway_participant.hpp"
+#include "replay/replay_source.hpp"
+#include "sim/scenario.hpp"
+#include "tof_decoder.hpp"
+
+namespace beaconloc::cli {
+
+// Where the gateway's data comes from: the built-in scenario, a scenario file or a recording.
+struct SourceChoice {
+  std::string scenario_file;  // empty: built-in default (unless replay_dir)
+  std::string replay_dir;
+  ReplayOptions replay;
+};
+
+struct LoadedSource {
+  SourceChoice choice;
+  std::uint64_t seed = 1;
+  std::unique_ptr<Source> source;
+  std::optional<sim::Scenario> scenario;  // when simulated
+  std::string label;                      // for titles and metrics.json
+};
+
+// Throws a std::runtime_error naming the file when it cannot be loaded. The seed and duration
+// default to the scenario's when not given (nullopt).
+LoadedSource load_source(const SourceChoice& choice, std::optional<std::uint64_t> seed);
+
+struct LocalizerSettings {
+  std::string estimator = "range_ekf";
+  std::string robot;  // empty: every robot
+  std::vector<std::string> parameters;  // NAME=VALUE
+  // Receivers in the robot frame, "x:y,x:y,...": empty for a circle of receiver_count at
+  // receiver_radius_m (the localizer alone) or the source's own receivers (demo, run).
+  std::string receivers;
+  double receiver_radius_m = 0.19;
+  int receiver_count = 3;
+  double receiver_height_m = 0.0;
+
+  // Throws std::invalid_argument naming the bad option. fallback: receivers when none given.
+  EstimatorConfig config(const std::optional<ReceiverArray>& fallback = std::nullopt) const;
+  // The arguments that give the same settings to `beaconloc localizer`.
+  std::vector<std::string> arguments(const std::optional<ReceiverArray>& fallback = std::nullopt) const;
+};
+
+struct PipelineOptions {
+  dds::DdsOptions dds;
+  GatewayOptions gateway;
+  TofDecoderConfig decoder;
+  LocalizerSettings localizer;
+  std::string out_dir;            // outputs written here when not empty
+  bool processes = false;         // one process per participant
+  bool print_poses = false;       // a pose line each second (demo)
+  bool print_progress = false;    // a progress line every 2 s (run)
+  StampNs score_from_ns = 0;      // settle time not scored, from the first pose
+};
+
+struct PipelineResult {
+  std::size_t poses = 0;
+  double pose_rate_hz = 0.0;
+  Metrics metrics;
+  std::string diagnostics;  // each participant's counts, one line each
+};
+
+// Runs to the end of the source (or the duration), then evaluates. With out_dir, writes
+// truth.csv, estimate.csv, beacons.csv, metrics.json, trajectory.svg and error.svg there.
+PipelineResult run_pipeline(const PipelineOptions& options, LoadedSource source, const std::string& self_exe);
+
+// `beaconloc eval`: metrics.json, trajectory.svg and error.svg from a truth and an estimate CSV.
+Metrics evaluate_files(const std::string& truth_csv, const std::string& estimate_csv, const std::string& out_dir,
+                       const std::string& beacons_csv, double max_truth_gap_s);
+
+std::string format_metrics(const Metrics& m);
+
+}  // namespace beaconloc::cli

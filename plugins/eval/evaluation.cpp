@@ -1,0 +1,266 @@
+#include "evaluation.hpp"
+
+#include <Eigen/Cholesky>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "beaconloc/core/pose_error.hpp"
+
+namespace beaconloc {
+namespace {
+
+// Two-sided 95 % band of the chi-square distribution (2.5 % and 97.5 % quantiles).
+constexpr double kChi2Band2[2] = {0.0506, 7.3778};
+constexpr double kChi2Band3[2] = {0.2158, 9.3484};
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string cell;
+  while (std::getline(ss, cell, ',')) out.push_back(cell);
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+double number(const std::string& cell, const std::string& where) {
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(cell.c_str(), &end);
+  if (cell.empty() || errno != 0 || end != cell.c_str() + cell.size() || !std::isfinite(v)) {
+    throw std::runtime_error(where + ": '" + cell + "' is not a finite number");
+  }
+  return v;
+}
+
+StampNs stamp(const std::string& cell, const std::string& where) {
+  errno = 0;
+  char* end = nullptr;
+  const long long v = std::strtoll(cell.c_str(), &end, 10);
+  if (cell.empty() || errno != 0 || end != cell.c_str() + cell.size()) {
+    throw std::runtime_error(where + ": '" + cell + "' is not an integer stamp in ns");
+  }
+  return v;
+}
+
+std::ifstream open_with_header(const std::string& path, const std::string& header) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read '" + path + "'");
+  std::string line;
+  std::getline(in, line);
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line != header) throw std::runtime_error(path + ":1: expected the header " + header);
+  return in;
+}
+
+const char* kEstimateHeader =
+    "robot_id,stamp_ns,x_m,y_m,yaw_rad,cov_00,cov_01,cov_02,cov_10,cov_11,cov_12,cov_20,cov_21,cov_22,status,"
+    "estimator";
+
+PoseStatus status_from(const std::string& s, const std::string& where) {
+  for (PoseStatus p : {PoseStatus::kInitializing, PoseStatus::kOk, PoseStatus::kDegraded, PoseStatus::kLost}) {
+    if (s == to_string(p)) return p;
+  }
+  throw std::runtime_error(where + ": unknown status '" + s + "'");
+}
+
+}  // namespace
+
+const std::vector<Eigen::Vector2d>& significant_points_base_m() {
+  // Seed 000, Section V (ERRATA: the fifth point is the mirror [-0.24, 0.2]).
+  static const std::vector<Eigen::Vector2d> points = {{0.2, 0.0}, {0.0, 0.2}, {0.0, -0.2}, {-0.24, -0.2}, {-0.24, 0.2}};
+  return points;
+}
+
+Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estimates, const EvaluationOptions& options) {
+  Metrics m;
+  bool all_have_yaw = true;
+  std::vector<std::pair<const EstimateRow*, TruthSample>> scored;
+  for (const auto& row : estimates) {
+    if (row.estimate.stamp_ns < options.score_from_ns) continue;
+    const auto t = truth.at(row.estimate.stamp_ns, options.max_truth_gap_ns);
+    if (!t) {
+      ++m.samples_without_truth;
+      continue;
+    }
+    all_have_yaw = all_have_yaw && t->has_yaw;
+    scored.emplace_back(&row, *t);
+  }
+  m.samples = scored.size();
+  if (scored.empty()) return m;
+  m.nees_dof = all_have_yaw ? 3 : 2;
+  PoseErrorAccumulator position;  // eq. 33 (and eq. 34 where truth has heading)
+  PoseErrorAccumulator heading;
+  double sum_es = 0;
+  std::size_t in_band = 0;
+  for (const auto& [row, t] : scored) {
+    const Pose2& est = row->estimate.pose_map_base;
+    const Pose2& gt = t.pose_map_base;
+    position.add(gt, est);
+    if (t.has_yaw) {
+      heading.add(gt, est);
+      double es_sq = 0;  // eq. 35 at this step
+      for (const auto& p : significant_points_base_m()) {
+        es_sq += (transform_point(gt, p) - transform_point(est, p)).squaredNorm();
+      }
+      sum_es += std::sqrt(es_sq / static_cast<double>(significant_points_base_m().size()));
+    }
+    double nees;
+    if (m.nees_dof == 3) {
+      Eigen::Vector3d e = gt - est;
+      e.z() = wrap_angle_rad(e.z());
+      nees = e.dot(row->estimate.covariance.ldlt().solve(e));
+      in_band += nees >= kChi2Band3[0] && nees <= kChi2Band3[1];
+    } else {
+      const Eigen::Vector2d e = gt.head<2>() - est.head<2>();
+      const Eigen::Matrix2d p = row->estimate.covariance.topLeftCorner<2, 2>();
+      nees = e.dot(p.ldlt().solve(e));
+      in_band += nees >= kChi2Band2[0] && nees <= kChi2Band2[1];
+    }
+  }
+  m.position_rms_m = position.position_rms_m();
+  m.position_mean_m = position.position_mean_m();
+  m.position_max_m = position.position_max_m();
+  m.nees_in_band_fraction = static_cast<double>(in_band) / static_cast<double>(scored.size());
+  if (heading.samples()) {
+    m.heading_rms_deg = heading.heading_rms_deg();
+    m.significant_points_mean_m = sum_es / static_cast<double>(heading.samples());
+  }
+  return m;
+}
+
+std::vector<ErrorPoint> error_series(const TruthTrack& truth, const std::vector<EstimateRow>& estimates,
+                                     const EvaluationOptions& options) {
+  std::vector<ErrorPoint> out;
+  if (estimates.empty()) return out;
+  const StampNs t0 = estimates.front().estimate.stamp_ns;
+  for (const auto& row : estimates) {
+    const auto t = truth.at(row.estimate.stamp_ns, options.max_truth_gap_ns);
+    if (!t) continue;
+    const Pose2& est = row.estimate.pose_map_base;
+    ErrorPoint p{ns_to_s(row.estimate.stamp_ns - t0), (t->pose_map_base.head<2>() - est.head<2>()).norm(), {}};
+    if (t->has_yaw) p.heading_deg = wrap_angle_rad(t->pose_map_base.z() - est.z()) * 180.0 / M_PI;
+    out.push_back(p);
+  }
+  return out;
+}
+
+TruthTrack load_truth_csv(const std::string& path) {
+  auto in = open_with_header(path, "stamp_ns,x_m,y_m,yaw_rad");
+  TruthTrack truth;
+  std::string line;
+  for (int n = 2; std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const std::string where = path + ":" + std::to_string(n);
+    const auto c = split(line);
+    if (c.size() != 4) throw std::runtime_error(where + ": expected 4 columns");
+    const bool has_yaw = !c[3].empty();
+    truth.add(stamp(c[0], where), {number(c[1], where), number(c[2], where), has_yaw ? number(c[3], where) : 0.0},
+              has_yaw);
+  }
+  return truth;
+}
+
+std::vector<EstimateRow> load_estimates_csv(const std::string& path) {
+  auto in = open_with_header(path, kEstimateHeader);
+  std::vector<EstimateRow> rows;
+  std::string line;
+  for (int n = 2; std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const std::string where = path + ":" + std::to_string(n);
+    const auto c = split(line);
+    if (c.size() != 16) throw std::runtime_error(where + ": expected 16 columns");
+    EstimateRow r;
+    r.robot_id = c[0];
+    r.estimate.stamp_ns = stamp(c[1], where);
+    r.estimate.pose_map_base = {number(c[2], where), number(c[3], where), number(c[4], where)};
+    for (int i = 0; i < 9; ++i) r.estimate.covariance(i / 3, i % 3) = number(c[5 + i], where);
+    r.estimate.status = status_from(c[14], where);
+    r.estimator = c[15];
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+void write_estimates_csv(const std::string& path, const std::vector<EstimateRow>& rows) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write '" + path + "'");
+  out << kEstimateHeader << '\n' << std::setprecision(12);
+  for (const auto& r : rows) {
+    const auto& e = r.estimate;
+    out << r.robot_id << ',' << e.stamp_ns << ',' << e.pose_map_base.x() << ',' << e.pose_map_base.y() << ','
+        << e.pose_map_base.z();
+    for (int i = 0; i < 9; ++i) out << ',' << e.covariance(i / 3, i % 3);
+    out << ',' << to_string(e.status) << ',' << r.estimator << '\n';
+  }
+  if (!out.flush()) throw std::runtime_error("writing '" + path + "' failed");
+}
+
+void write_metrics_json(const std::string& path, const Metrics& m, const std::string& estimator,
+                        const std::string& source) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write '" + path + "'");
+  auto quoted = [](const std::string& s) {
+    std::string q = "\"";
+    for (char ch : s) {
+      if (ch == '"' || ch == '\\') q += '\\';
+      q += ch;
+    }
+    return q + "\"";
+  };
+  auto optional = [](const std::optional<double>& v) {
+    std::ostringstream s;
+    s << std::setprecision(6);
+    if (v) s << *v; else s << "null";
+    return s.str();
+  };
+  out << std::setprecision(6) << "{\n"
+      << "  \"estimator\": " << quoted(estimator) << ",\n"
+      << "  \"source\": " << quoted(source) << ",\n"
+      << "  \"samples\": " << m.samples << ",\n"
+      << "  \"samples_without_truth\": " << m.samples_without_truth << ",\n"
+      << "  \"position_rms_m\": " << m.position_rms_m << ",\n"
+      << "  \"position_mean_m\": " << m.position_mean_m << ",\n"
+      << "  \"position_max_m\": " << m.position_max_m << ",\n"
+      << "  \"heading_rms_deg\": " << optional(m.heading_rms_deg) << ",\n"
+      << "  \"significant_points_mean_m\": " << optional(m.significant_points_mean_m) << ",\n"
+      << "  \"nees_in_band_fraction\": " << m.nees_in_band_fraction << ",\n"
+      << "  \"nees_dof\": " << m.nees_dof << "\n"
+      << "}\n";
+  if (!out.flush()) throw std::runtime_error("writing '" + path + "' failed");
+}
+
+void write_beacons_csv(const std::string& path, const BeaconMap& map) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write '" + path + "'");
+  out << "beacon_id,x_m,y_m,z_m\n" << std::setprecision(10);
+  for (const auto& b : map.beacons()) {
+    out << b.id << ',' << b.position_map_m.x() << ',' << b.position_map_m.y() << ',' << b.position_map_m.z() << '\n';
+  }
+  if (!out.flush()) throw std::runtime_error("writing '" + path + "' failed");
+}
+
+BeaconMap load_beacons_csv(const std::string& path) {
+  auto in = open_with_header(path, "beacon_id,x_m,y_m,z_m");
+  std::vector<Beacon> beacons;
+  std::string line;
+  for (int n = 2; std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    const std::string where = path + ":" + std::to_string(n);
+    const auto c = split(line);
+    if (c.size() != 4) throw std::runtime_error(where + ": expected 4 columns");
+    const double id = number(c[0], where);
+    if (id < 0 || id != std::floor(id) || id >= 4294967295.0) throw std::runtime_error(where + ": bad beacon id");
+    beacons.push_back({static_cast<std::uint32_t>(id), {number(c[1], where), number(c[2], where), number(c[3], where)}, 0});
+  }
+  return BeaconMap(beacons);
+}
+
+}  // namespace beaconloc

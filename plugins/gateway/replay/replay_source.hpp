@@ -1,0 +1,75 @@
+#pragma once
+// Replays a recording in the common CSV layout of ../shared/datasets/*/replay/ (documented in
+// docs/replay-format.md): odom.csv (t_s, dt_s, v_mps, omega_radps), ranges.csv (t_s, beacon_id,
+// range_m), beacons.csv (beacon_id, x_m, y_m, z_m), optional gt.csv (t_s, x_m, y_m[, yaw_rad]).
+// Extra columns are allowed and ignored. A malformed or out-of-order row is skipped and
+// counted by reason (reported with its file and line); a missing file or header is an error.
+// Ranges filed out of stamp order are replayed in stamp order (and said in load_notes()).
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/rejection_counter.hpp"
+#include "source.hpp"
+
+namespace beaconloc {
+
+class ReplayError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ReplayOptions {
+  // The recording gives (v, omega); the Odometry topic carries wheel velocities. Any wheel base
+  // converts exactly; a half_track_m column, when present, gives the robot's own.
+  double wheel_base_m = 0.5;
+  // Odometry noise reported with each sample (seed 000's model, sigma_v^2 = k_v |v| / dT per
+  // wheel): recordings carry none.
+  double odometry_k_v_m = 4e-4;
+  // Ranges travel as TOF: tof = range / c(T), with this temperature reported alongside, so the
+  // decoder recovers each range exactly.
+  double reference_temperature_c = 20.0;
+};
+
+class ReplaySource final : public Source {
+ public:
+  ReplaySource(const std::string& directory, ReplayOptions options = {});
+  void advance(StampNs until_ns, std::vector<SourceEvent>& out) override;
+  bool exhausted() const override { return next_ >= events_.size(); }
+  bool finite() const override { return true; }
+  BeaconMap beacon_map() const override { return map_; }
+  ReceiverArray receivers() const override;
+  StampNs first_stamp_ns() const override { return events_.empty() ? 0 : events_.front().stamp_ns; }
+  StampNs last_stamp_ns() const override { return events_.empty() ? 0 : events_.back().stamp_ns; }
+  bool relative_stamps() const override { return false; }
+  std::string describe() const override { return "replay " + directory_; }
+  RejectionCounter input_rejections() const override { return load_counts_; }
+
+  // Rows refused while loading, by reason (e.g. "odom.malformed_row"), and the first problems
+  // with file and line.
+  const RejectionCounter& load_counts() const { return load_counts_; }
+  const std::vector<std::string>& load_problems() const { return problems_; }
+  // Things worth saying that refuse nothing (ranges filed out of stamp order).
+  const std::vector<std::string>& load_notes() const { return notes_; }
+  std::size_t event_count() const { return events_.size(); }
+  bool has_truth_yaw() const { return truth_has_yaw_; }
+
+ private:
+  void load_beacons(const std::string& path);
+  void load_odometry(const std::string& path);
+  void load_ranges(const std::string& path);
+  void load_truth(const std::string& path);
+  void refuse(const std::string& file, std::size_t line, const std::string& reason, const std::string& detail);
+
+  std::string directory_;
+  ReplayOptions options_;
+  BeaconMap map_;
+  std::vector<SourceEvent> events_;
+  std::size_t next_ = 0;
+  bool truth_has_yaw_ = false;
+  RejectionCounter load_counts_;
+  std::vector<std::string> problems_;
+  std::vector<std::string> notes_;
+};
+
+}  // namespace beaconloc

@@ -1,0 +1,290 @@
+#include "scenario_yaml.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace beaconloc::sim {
+namespace {
+
+// A mapping node with the dotted key path that leads to it, for messages, and the keys a
+// schema allows there.
+class Section {
+ public:
+  Section(const YAML::Node& node, std::string path, std::string origin, std::set<std::string> allowed)
+      : node_(node), path_(std::move(path)), origin_(std::move(origin)) {
+    if (!node_.IsMap()) fail(path_.empty() ? "the document" : path_, "must be a mapping", node_);
+    for (const auto& kv : node_) {
+      const std::string key = kv.first.as<std::string>();
+      if (!allowed.count(key)) fail(join(key), "is not a known key", kv.first);
+    }
+  }
+
+  bool has(const std::string& key) const { return node_[key] && !node_[key].IsNull(); }
+
+  template <class T>
+  T get(const std::string& key, T fallback) const {
+    return has(key) ? as<T>(node_[key], join(key)) : fallback;
+  }
+  template <class T>
+  T required(const std::string& key) const {
+    if (!has(key)) fail(join(key), "is required", node_);
+    return as<T>(node_[key], join(key));
+  }
+  double number(const std::string& key, double fallback, double min, double max) const {
+    const double v = get<double>(key, fallback);
+    if (!std::isfinite(v) || v < min || v > max) {
+      std::ostringstream range;
+      range << "must be in [" << min << ", " << max << "], got " << v;
+      fail(join(key), range.str(), node_[key] ? node_[key] : node_);
+    }
+    return v;
+  }
+  Section child(const std::string& key, std::set<std::string> allowed) const {
+    return Section(node_[key], join(key), origin_, std::move(allowed));
+  }
+  YAML::Node node(const std::string& key) const { return node_[key]; }
+  std::string join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  const std::string& origin() const { return origin_; }
+
+  [[noreturn]] void fail(const std::string& what, const std::string& why, const YAML::Node& at) const {
+    std::ostringstream msg;
+    msg << origin_;
+    // A missing key has no place of its own: point at the mapping that lacks it.
+    const YAML::Mark mark = at.IsDefined() ? at.Mark() : node_.Mark();
+    if (mark.line >= 0) msg << ':' << mark.line + 1;
+    msg << ": '" << what << "' " << why;
+    throw ScenarioError(msg.str());
+  }
+
+  template <class T>
+  T as(const YAML::Node& n, const std::string& what) const {
+    try {
+      return n.as<T>();
+    } catch (const YAML::Exception&) {
+      fail(what, "has the wrong type", n);
+    }
+  }
+
+ private:
+  YAML::Node node_;
+  std::string path_;
+  std::string origin_;
+};
+
+Eigen::Vector2d vec2(const Section& s, const YAML::Node& n, const std::string& what) {
+  const auto v = s.as<std::vector<double>>(n, what);
+  if (v.size() != 2 || !std::isfinite(v[0]) || !std::isfinite(v[1])) s.fail(what, "must be [x, y]", n);
+  return {v[0], v[1]};
+}
+
+Eigen::Vector3d vec3(const Section& s, const YAML::Node& n, const std::string& what) {
+  const auto v = s.as<std::vector<double>>(n, what);
+  if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
+    s.fail(what, "must be three finite numbers", n);
+  }
+  return {v[0], v[1], v[2]};
+}
+
+StampNs duration_ns(const Section& s, const std::string& key, double fallback_s) {
+  return s_to_ns(s.number(key, fallback_s, 1e-4, 3600.0));
+}
+
+void read_beacons(const Section& root, Scenario& sc) {
+  if (!root.has("beacons") || !root.node("beacons").IsSequence() || root.node("beacons").size() == 0) {
+    root.fail("beacons", "is required: a list of at least one beacon", root.node("beacons"));
+  }
+  std::set<std::uint32_t> ids;
+  const YAML::Node list = root.node("beacons");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const Section b(list[i], "beacons[" + std::to_string(i) + "]", root.origin(), {"id", "position_m", "group"});
+    Beacon beacon;
+    beacon.id = b.required<std::uint32_t>("id");
+    if (beacon.id == kBeaconUnidentified) b.fail(b.join("id"), "is reserved for unidentified pulses", list[i]);
+    if (!ids.insert(beacon.id).second) b.fail(b.join("id"), "repeats an earlier beacon id", list[i]);
+    if (!b.has("position_m")) b.fail(b.join("position_m"), "is required", list[i]);
+    beacon.position_map_m = vec3(b, b.node("position_m"), b.join("position_m"));
+    beacon.group = b.get<std::uint32_t>("group", 0);
+    sc.beacons.push_back(beacon);
+  }
+}
+
+void read_beacon_system(const Section& root, Scenario& sc) {
+  for (const auto& b : sc.beacons) sc.firing_order.push_back(b.id);
+  if (!root.has("beacon_system")) return;
+  const Section s = root.child("beacon_system", {"slot_period_s", "first_slot_s", "firing_order", "identified",
+                                                  "marked_beacon_id", "range_sigma_m", "tof_sigma_s",
+                                                  "min_range_m", "max_range_m", "beam_half_angle_deg",
+                                                  "temperature_c", "reported_temperature_c", "echo"});
+  sc.slot_period_ns = duration_ns(s, "slot_period_s", 0.2);
+  sc.first_slot_ns = s_to_ns(s.number("first_slot_s", 0.05, 0.0, 3600.0));
+  if (s.has("firing_order")) {
+    sc.firing_order = s.as<std::vector<std::uint32_t>>(s.node("firing_order"), s.join("firing_order"));
+    if (sc.firing_order.empty()) s.fail(s.join("firing_order"), "must not be empty", s.node("firing_order"));
+    for (auto id : sc.firing_order) {
+      bool known = false;
+      for (const auto& b : sc.beacons) known = known || b.id == id;
+      if (!known) s.fail(s.join("firing_order"), "names beacon " + std::to_string(id) + ", which is not in beacons", s.node("firing_order"));
+    }
+  }
+  sc.identified = s.get<bool>("identified", true);
+  if (s.has("marked_beacon_id")) sc.marked_beacon_id = s.get<std::uint32_t>("marked_beacon_id", 0);
+  sc.range_sigma_m = s.number("range_sigma_m", 0.01, 0.0, 100.0);
+  sc.tof_sigma_s = s.number("tof_sigma_s", 0.0, 0.0, 1.0);
+  sc.min_range_m = s.number("min_range_m", 0.0, 0.0, 1e4);
+  sc.max_range_m = s.number("max_range_m", 5.0, 0.0, 1e4);
+  if (sc.max_range_m <= sc.min_range_m) s.fail(s.join("max_range_m"), "must exceed min_range_m", s.node("max_range_m"));
+  sc.beam_half_angle_rad = s.number("beam_half_angle_deg", 90.0, 0.1, 180.0) * M_PI / 180.0;
+  sc.temperature_c = s.number("temperature_c", 22.0, -40.0, 60.0);
+  if (s.has("reported_temperature_c")) sc.reported_temperature_c = s.number("reported_temperature_c", 0.0, -40.0, 60.0);
+  if (s.has("echo")) {
+    const Section e = s.child("echo", {"probability", "min_extra_path_m", "max_extra_path_m"});
+    sc.echo.probability = e.number("probability", 0.0, 0.0, 1.0);
+    sc.echo.min_extra_path_m = e.number("min_extra_path_m", 0.3, 0.0, 1e3);
+    sc.echo.max_extra_path_m = e.number("max_extra_path_m", 3.0, sc.echo.min_extra_path_m, 1e3);
+  }
+}
+
+void read_robot(const Section& root, Scenario& sc) {
+  if (!root.has("robot")) root.fail("robot", "is required", root.node("robot"));
+  const Section r = root.child("robot", {"wheel_base_m", "receivers", "odometry"});
+  sc.wheel_base_m = r.number("wheel_base_m", 0.33, 0.01, 10.0);
+  if (!r.has("receivers")) r.fail(r.join("receivers"), "is required", r.node("receivers"));
+  const Section rx = r.child("receivers", {"height_m", "positions_m", "circle"});
+  if (rx.has("positions_m") == rx.has("circle")) {
+    rx.fail(rx.join("positions_m"), "or 'circle' is required, not both", r.node("receivers"));
+  }
+  if (rx.has("circle")) {
+    const Section c = rx.child("circle", {"radius_m", "count"});
+    sc.receivers = ReceiverArray::on_circle(c.number("radius_m", 0.19, 0.0, 10.0),
+                                            static_cast<int>(c.number("count", 3, 1, 16)));
+  } else {
+    const YAML::Node list = rx.node("positions_m");
+    if (!list.IsSequence() || list.size() == 0) rx.fail(rx.join("positions_m"), "must list receivers", list);
+    sc.receivers.receivers_base_m.clear();
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      sc.receivers.receivers_base_m.push_back(vec2(rx, list[i], rx.join("positions_m") + "[" + std::to_string(i) + "]"));
+    }
+  }
+  sc.receivers.receiver_height_m = rx.number("height_m", 0.0, -10.0, 10.0);
+  if (r.has("odometry")) {
+    const Section o = r.child("odometry", {"period_s", "k_v_m", "wheel_radius_error_right",
+                                           "wheel_radius_error_left", "wheel_base_error"});
+    sc.odometry_period_ns = duration_ns(o, "period_s", 0.01);
+    sc.odometry_k_v_m = o.number("k_v_m", 4e-4, 0.0, 1.0);
+    sc.wheel_radius_error_right = o.number("wheel_radius_error_right", 0.0, -0.5, 0.5);
+    sc.wheel_radius_error_left = o.number("wheel_radius_error_left", 0.0, -0.5, 0.5);
+    sc.wheel_base_error = o.number("wheel_base_error", 0.0, -0.5, 0.5);
+  }
+}
+
+void read_trajectory(const Section& root, Scenario& sc) {
+  if (!root.has("trajectory")) root.fail("trajectory", "is required", root.node("trajectory"));
+  const Section t = root.child("trajectory", {"start_pose", "loop", "segments", "waypoints_m", "speed_mps",
+                                              "turn_rate_radps"});
+  if (t.has("segments") == t.has("waypoints_m")) {
+    t.fail(t.join("segments"), "or 'waypoints_m' is required, not both", root.node("trajectory"));
+  }
+  if (t.has("segments")) {
+    const YAML::Node list = t.node("segments");
+    if (!list.IsSequence() || list.size() == 0) t.fail(t.join("segments"), "must list segments", list);
+    std::vector<VelocitySegment> segments;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const Section s(list[i], t.join("segments") + "[" + std::to_string(i) + "]", root.origin(),
+                      {"duration_s", "linear_mps", "angular_radps"});
+      if (!s.has("duration_s")) s.fail(s.join("duration_s"), "is required", list[i]);
+      segments.push_back({s.number("duration_s", 0.0, 1e-6, 1e5), s.number("linear_mps", 0.0, -10.0, 10.0),
+                          s.number("angular_radps", 0.0, -10.0, 10.0)});
+    }
+    if (!t.has("start_pose")) t.fail(t.join("start_pose"), "is required with segments", root.node("trajectory"));
+    sc.trajectory = Trajectory(vec3(t, t.node("start_pose"), t.join("start_pose")), segments, t.get<bool>("loop", false));
+    return;
+  }
+  if (t.has("start_pose") || t.has("loop")) {
+    t.fail(t.join("waypoints_m"), "paths start at their first waypoint and do not loop", root.node("trajectory"));
+  }
+  const YAML::Node list = t.node("waypoints_m");
+  std::vector<Eigen::Vector2d> waypoints;
+  for (std::size_t i = 0; list.IsSequence() && i < list.size(); ++i) {
+    waypoints.push_back(vec2(t, list[i], t.join("waypoints_m") + "[" + std::to_string(i) + "]"));
+  }
+  if (!t.has("speed_mps")) t.fail(t.join("speed_mps"), "is required with waypoints_m", root.node("trajectory"));
+  try {
+    sc.trajectory = Trajectory::from_waypoints(waypoints, t.number("speed_mps", 0.0, 1e-3, 10.0),
+                                               t.number("turn_rate_radps", 0.5, 1e-3, 10.0));
+  } catch (const std::invalid_argument& e) {
+    t.fail(t.join("waypoints_m"), e.what(), list);
+  }
+}
+
+void read_map_and_laser(const Section& root, Scenario& sc) {
+  if (root.has("map")) {
+    const Section m = root.child("map", {"resolution_m", "origin_m", "size_m", "border", "obstacles"});
+    const double res = m.number("resolution_m", 0.1, 0.005, 10.0);
+    if (!m.has("size_m")) m.fail(m.join("size_m"), "is required", root.node("map"));
+    const Eigen::Vector2d size = vec2(m, m.node("size_m"), m.join("size_m"));
+    if (size.minCoeff() <= 0.0 || size.maxCoeff() / res > 20000) m.fail(m.join("size_m"), "must be positive and at most 20000 cells a side", m.node("size_m"));
+    const Eigen::Vector2d origin = m.has("origin_m") ? vec2(m, m.node("origin_m"), m.join("origin_m")) : Eigen::Vector2d::Zero();
+    OccupancyGrid grid(origin, res, static_cast<int>(std::ceil(size.x() / res - 1e-9)),
+                       static_cast<int>(std::ceil(size.y() / res - 1e-9)));
+    if (m.get<bool>("border", true)) grid.fill_border();
+    const YAML::Node obstacles = m.node("obstacles");
+    for (std::size_t i = 0; obstacles && obstacles.IsSequence() && i < obstacles.size(); ++i) {
+      const Section o(obstacles[i], m.join("obstacles") + "[" + std::to_string(i) + "]", root.origin(), {"min_m", "max_m"});
+      if (!o.has("min_m") || !o.has("max_m")) o.fail(o.join("min_m"), "and max_m are required", obstacles[i]);
+      const Eigen::Vector2d lo = vec2(o, o.node("min_m"), o.join("min_m")), hi = vec2(o, o.node("max_m"), o.join("max_m"));
+      if ((hi.array() <= lo.array()).any()) o.fail(o.join("max_m"), "must exceed min_m", obstacles[i]);
+      grid.fill_rectangle(lo, hi);
+    }
+    sc.map = grid;
+  }
+  if (root.has("laser")) {
+    if (!sc.map) root.fail("laser", "needs a map to cast its rays on", root.node("laser"));
+    const Section l = root.child("laser", {"beams", "fov_deg", "period_s", "range_sigma_m", "max_range_m", "mount_m"});
+    LaserModel laser;
+    laser.beams = static_cast<int>(l.number("beams", 19, 1, 4096));
+    laser.fov_rad = l.number("fov_deg", 180.0, 0.0, 360.0) * M_PI / 180.0;
+    laser.period_ns = duration_ns(l, "period_s", 0.022);
+    laser.range_sigma_m = l.number("range_sigma_m", 0.1, 0.0, 10.0);
+    laser.max_range_m = l.number("max_range_m", 8.0, 0.01, 1e3);
+    if (l.has("mount_m")) laser.mount_base = vec3(l, l.node("mount_m"), l.join("mount_m"));
+    sc.laser = laser;
+  }
+}
+
+}  // namespace
+
+Scenario parse_scenario(const std::string& yaml_text, const std::string& origin) {
+  YAML::Node doc;
+  try {
+    doc = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw ScenarioError(origin + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+  }
+  const Section root(doc, "", origin, {"name", "description", "seed", "duration_s", "beacons", "beacon_system",
+                                       "robot", "trajectory", "map", "laser"});
+  Scenario sc;
+  sc.name = root.required<std::string>("name");
+  sc.description = root.get<std::string>("description", "");
+  sc.seed = root.get<std::uint64_t>("seed", 1);
+  sc.duration_s = root.number("duration_s", 20.0, 0.01, 1e6);
+  read_beacons(root, sc);
+  read_beacon_system(root, sc);
+  read_robot(root, sc);
+  read_trajectory(root, sc);
+  read_map_and_laser(root, sc);
+  return sc;
+}
+
+Scenario load_scenario_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ScenarioError("cannot read scenario file '" + path + "'");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_scenario(text.str(), path);
+}
+
+}  // namespace beaconloc::sim

@@ -1,0 +1,56 @@
+#pragma once
+// What a beacon-gateway publishes, from whichever source: the simulator, a replayed recording
+// (or, later, the hardware). DDS-free.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/beacon_map.hpp"
+#include "beaconloc/core/measurements.hpp"
+#include "beaconloc/core/pose2.hpp"
+#include "beaconloc/core/receiver_array.hpp"
+#include "beaconloc/core/rejection_counter.hpp"
+
+namespace beaconloc {
+
+struct SourceEvent {
+  enum class Kind { kOdometry, kTof, kLaserScan, kTruth };
+  Kind kind = Kind::kOdometry;
+  StampNs stamp_ns = 0;  // odometry stamp, arrival of a pulse, scan or truth time
+
+  OdometrySample odometry;  // kOdometry
+  RawTofSample tof;         // kTof
+  std::uint32_t true_beacon_id = kBeaconUnidentified;  // kTof: who fired, for evaluation only
+  bool tof_is_echo = false;                            // kTof: simulated echo, for evaluation only
+  LaserScanSample scan;     // kLaserScan
+
+  // Ground truth at stamp_ns: on kTruth events, and on the simulator's kOdometry events.
+  bool has_truth = false;
+  Pose2 truth_map_base = Pose2::Zero();
+  bool truth_has_yaw = true;
+};
+
+class Source {
+ public:
+  virtual ~Source() = default;
+  // Appends, in stamp order, every event with stamp_ns <= until_ns.
+  virtual void advance(StampNs until_ns, std::vector<SourceEvent>& out) = 0;
+  // No event will come after the ones already given (the end of a recording).
+  virtual bool exhausted() const = 0;
+  // A recording ends; a simulation runs for as long as it is asked to.
+  virtual bool finite() const = 0;
+  virtual BeaconMap beacon_map() const = 0;
+  virtual ReceiverArray receivers() const = 0;
+  // Stamp of the first event; simulated time starts at 0.
+  virtual StampNs first_stamp_ns() const = 0;
+  // Last stamp of a recording; the scenario's default duration for a simulation.
+  virtual StampNs last_stamp_ns() const = 0;
+  // True when stamps are relative (simulated time from 0): the gateway offsets them to the wall
+  // clock. A recording keeps its own clock.
+  virtual bool relative_stamps() const = 0;
+  virtual std::string describe() const = 0;
+  // Input the source refused while reading it (a recording's malformed rows), by reason.
+  virtual RejectionCounter input_rejections() const { return {}; }
+};
+
+}  // namespace beaconloc

@@ -1,0 +1,155 @@
+// `beaconloc run` and `beaconloc eval` as a user runs them: deterministic by seed, replaying
+// recordings, in one process or one per participant, with metrics and plots written.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "domain_id.hpp"
+#include "process.hpp"
+
+namespace beaconloc::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+const std::string kSource = BEACONLOC_SOURCE_DIR;
+const std::string kShared = kSource + "/../shared/datasets";
+
+std::string read(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+double json_number(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\": ");
+  if (at == std::string::npos) throw std::runtime_error("no " + key + " in " + json);
+  return std::stod(json.substr(at + key.size() + 4));
+}
+
+class Run : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char dir[] = "/tmp/beaconloc-run-XXXXXX";
+    ASSERT_NE(::mkdtemp(dir), nullptr);
+    dir_ = dir;
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::pair<int, std::string> beaconloc(std::vector<std::string> args) {
+    args.insert(args.begin(), BEACONLOC_EXECUTABLE);
+    args.push_back("--domain");
+    args.push_back(std::to_string(domain_.id()));
+    return run_command(args, 300s);
+  }
+  std::pair<int, std::string> eval(std::vector<std::string> args) {
+    args.insert(args.begin(), {BEACONLOC_EXECUTABLE, "eval"});
+    return run_command(args, 60s);
+  }
+  DomainLease domain_;
+  std::string dir_;
+};
+
+TEST_F(Run, SameSeedSameFilesOtherSeedOtherMeasurements) {
+  for (const char* name : {"a", "b"}) {
+    const auto [code, out] = beaconloc({"run", "--duration-s", "10", "--seed", "3", "--out", dir_ + "/" + name});
+    ASSERT_EQ(code, 0) << out;
+  }
+  const auto [code, out] = beaconloc({"run", "--duration-s", "10", "--seed", "4", "--out", dir_ + "/c"});
+  ASSERT_EQ(code, 0) << out;
+  for (const char* file : {"truth.csv", "tof.csv", "odometry.csv"}) {
+    EXPECT_EQ(read(dir_ + "/a/" + file), read(dir_ + "/b/" + file)) << file;
+  }
+  EXPECT_EQ(read(dir_ + "/a/truth.csv"), read(dir_ + "/c/truth.csv"));  // the same path...
+  EXPECT_NE(read(dir_ + "/a/tof.csv"), read(dir_ + "/c/tof.csv"));      // ...measured with other noise
+  EXPECT_NE(read(dir_ + "/a/odometry.csv"), read(dir_ + "/c/odometry.csv"));
+  for (const char* file : {"estimate.csv", "metrics.json", "trajectory.svg", "error.svg", "beacons.csv"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir_ + "/a/" + file)) << file;
+  }
+  const std::string metrics = read(dir_ + "/a/metrics.json");
+  EXPECT_LT(json_number(metrics, "position_rms_m"), 0.05);
+  EXPECT_GT(json_number(metrics, "samples"), 900);
+}
+
+TEST_F(Run, EvalReproducesTheMetricsOfARun) {
+  const auto [code, out] = beaconloc({"run", "--duration-s", "8", "--out", dir_ + "/run"});
+  ASSERT_EQ(code, 0) << out;
+  const auto [eval_code, eval_out] = eval({"--truth", dir_ + "/run/truth.csv", "--estimate",
+                                           dir_ + "/run/estimate.csv", "--beacons", dir_ + "/run/beacons.csv",
+                                           "--out", dir_ + "/eval"});
+  ASSERT_EQ(eval_code, 0) << eval_out;
+  const std::string a = read(dir_ + "/run/metrics.json"), b = read(dir_ + "/eval/metrics.json");
+  for (const char* key : {"samples", "position_rms_m", "position_max_m", "position_mean_m", "heading_rms_deg",
+                          "significant_points_mean_m", "nees_in_band_fraction"}) {
+    EXPECT_DOUBLE_EQ(json_number(a, key), json_number(b, key)) << key;
+  }
+  EXPECT_TRUE(std::filesystem::exists(dir_ + "/eval/trajectory.svg"));
+  const auto [bad_code, bad_out] = eval({"--truth", dir_ + "/run/estimate.csv", "--estimate",
+                                         dir_ + "/run/estimate.csv", "--out", dir_ + "/bad"});
+  EXPECT_NE(bad_code, 0);
+  EXPECT_NE(bad_out.find("expected the header"), std::string::npos) << bad_out;
+}
+
+TEST_F(Run, ReplaysTheTucFixture) {
+  const auto [code, out] = beaconloc({"run", "--replay", kSource + "/tests/data/tuc_labyrinth_30s", "--max-range-m",
+                                      "10", "--range-sigma-m", "0.15", "--param", "init_window_s=5", "--out", dir_});
+  ASSERT_EQ(code, 0) << out;
+  const std::string metrics = read(dir_ + "/metrics.json");
+  EXPECT_GT(json_number(metrics, "samples"), 150);
+  EXPECT_LT(json_number(metrics, "position_rms_m"), 0.5);
+  EXPECT_NE(metrics.find("\"heading_rms_deg\": null"), std::string::npos);  // the recording has no heading
+}
+
+TEST_F(Run, OneProcessPerParticipant) {
+  const auto [code, out] = beaconloc({"run", "--processes", "--speed", "4", "--duration-s", "12", "--out", dir_});
+  ASSERT_EQ(code, 0) << out;
+  const std::string metrics = read(dir_ + "/metrics.json");
+  EXPECT_GT(json_number(metrics, "samples"), 800);
+  EXPECT_LT(json_number(metrics, "position_rms_m"), 0.15);
+  EXPECT_TRUE(std::filesystem::exists(dir_ + "/localizer.log"));
+}
+
+TEST_F(Run, ScenarioErrorsAreReportedWithTheFile) {
+  std::ofstream(dir_ + "/bad.yaml") << "name: x\nbeacons: [{id: 1, position_m: [0, 0]}]\n";
+  const auto [code, out] = beaconloc({"run", "--scenario", dir_ + "/bad.yaml", "--out", dir_ + "/o"});
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(out.find("bad.yaml:2: 'beacons[0].position_m' must be three finite numbers"), std::string::npos) << out;
+}
+
+// The real recordings of ../shared/datasets, as the README runs them (skipped without them).
+struct Recording {
+  const char* dir;
+  std::vector<std::string> options;
+  double max_rms_m;  // a bound far above the figures in the README: the run works, it is not tuned
+};
+
+TEST_F(Run, ReplaysTheSharedRecordings) {
+  const std::vector<Recording> recordings = {
+      {"tuc_labyrinth_uwb/replay/full_933s",
+       {"--max-range-m", "10", "--range-sigma-m", "0.15", "--param", "init_window_s=5"}, 0.5},
+      {"cmu_plaza_gpslam/replay/plaza1",
+       {"--max-range-m", "150", "--range-sigma-m", "1.0", "--range-scale", "1.069", "--replay-odometry-k-v", "0.002",
+        "--param", "init_window_s=20", "--param", "max_odometry_gap_s=0.5", "--param",
+        "init_max_position_sigma_m=2", "--param", "init_max_yaw_sigma_rad=0.5"},
+       2.0}};
+  for (const auto& r : recordings) {
+    const std::string path = kShared + "/" + r.dir;
+    if (!std::filesystem::exists(path)) {
+      std::printf("skipped %s: the shared datasets are not beside the repository (%s)\n", r.dir, path.c_str());
+      continue;
+    }
+    std::vector<std::string> args{"run", "--replay", path, "--out", dir_ + "/" + std::filesystem::path(r.dir).filename().string()};
+    args.insert(args.end(), r.options.begin(), r.options.end());
+    const auto [code, out] = beaconloc(args);
+    ASSERT_EQ(code, 0) << out;
+    const std::string metrics = read(dir_ + "/" + std::filesystem::path(r.dir).filename().string() + "/metrics.json");
+    std::printf("%s: %s", r.dir, metrics.c_str());
+    EXPECT_LT(json_number(metrics, "position_rms_m"), r.max_rms_m) << r.dir;
+    EXPECT_GT(json_number(metrics, "samples"), 5000) << r.dir;
+  }
+}
+
+}  // namespace
+}  // namespace beaconloc::testing

@@ -1,0 +1,97 @@
+// Scenario files: every shipped file loads; the built-in default is default.yaml; a bad file
+// gets an error naming the key and its line.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "sim/scenario_yaml.hpp"
+#include "sim/sim_source.hpp"
+
+namespace beaconloc::sim {
+namespace {
+
+const std::string kScenarioDir = std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios";
+
+TEST(ScenarioYaml, EveryShippedScenarioLoads) {
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(kScenarioDir)) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    const Scenario s = load_scenario_file(entry.path().string());
+    EXPECT_FALSE(s.beacons.empty());
+    EXPECT_FALSE(s.receivers.receivers_base_m.empty());
+    EXPECT_GT(s.duration_s, 0.0);
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 9);  // default + seed 000 x4 + seeds 001-004
+}
+
+TEST(ScenarioYaml, DefaultFileIsTheBuiltInScenario) {
+  const Scenario file = load_scenario_file(kScenarioDir + "/default.yaml");
+  SimSource a(file, 5), b(default_scenario(), 5);
+  std::vector<SourceEvent> ea, eb;
+  a.advance(s_to_ns(30.0), ea);
+  b.advance(s_to_ns(30.0), eb);
+  ASSERT_EQ(ea.size(), eb.size());
+  for (std::size_t i = 0; i < ea.size(); ++i) {
+    ASSERT_EQ(ea[i].stamp_ns, eb[i].stamp_ns);
+    ASSERT_NEAR(ea[i].tof.tof_s, eb[i].tof.tof_s, 1e-12);
+    ASSERT_TRUE(ea[i].truth_map_base.isApprox(eb[i].truth_map_base, 1e-6) ||
+                (ea[i].truth_map_base - eb[i].truth_map_base).norm() < 1e-6);
+  }
+}
+
+const char* kMinimal = R"(name: t
+beacons:
+  - {id: 1, position_m: [0, 0, 2]}
+robot:
+  receivers: {positions_m: [[0, 0]]}
+trajectory:
+  waypoints_m: [[0, 0], [1, 0]]
+  speed_mps: 0.5
+)";
+
+std::string error_of(const std::string& yaml) {
+  try {
+    parse_scenario(yaml, "test.yaml");
+  } catch (const ScenarioError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ScenarioYaml, MinimalFileUsesTheDocumentedDefaults) {
+  const Scenario s = parse_scenario(kMinimal);
+  EXPECT_EQ(s.slot_period_ns, 200 * kNsPerMillisecond);
+  EXPECT_DOUBLE_EQ(s.range_sigma_m, 0.01);
+  EXPECT_TRUE(s.identified);
+  EXPECT_EQ(s.firing_order, std::vector<std::uint32_t>{1});
+  EXPECT_FALSE(s.map);
+  EXPECT_NEAR(s.trajectory.period_s(), 2.0, 1e-12);
+}
+
+TEST(ScenarioYaml, ErrorsNameTheKeyAndLine) {
+  EXPECT_EQ(error_of(std::string(kMinimal) + "colour: red\n"), "test.yaml:9: 'colour' is not a known key");
+  EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {range_sigma_m: -1}\n").find("'beacon_system.range_sigma_m' must be in"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {identified: maybe}\n").find("'beacon_system.identified' has the wrong type"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {firing_order: [7]}\n").find("names beacon 7"),
+            std::string::npos);
+  EXPECT_NE(error_of("name: t\n").find("'beacons' is required"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kMinimal) + "laser: {beams: 3}\n").find("needs a map"), std::string::npos);
+  EXPECT_NE(error_of("name: [unclosed\n").find("not valid YAML"), std::string::npos);
+  std::string dup = kMinimal;
+  dup.insert(dup.find("robot:"), "  - {id: 1, position_m: [1, 0, 2]}\n");
+  EXPECT_NE(error_of(dup).find("repeats an earlier beacon id"), std::string::npos);
+  EXPECT_NE(error_of("name: t\nbeacons: []\n").find("at least one beacon"), std::string::npos);
+  try {
+    load_scenario_file("/nonexistent.yaml");
+    FAIL();
+  } catch (const ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent.yaml"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace beaconloc::sim
