@@ -1,7 +1,6 @@
 // beaconloc: one executable, one subcommand per participant (gateway, decoder, localizer), the
 // whole pipeline on a source (demo, run), scoring of recorded tracks (eval), and a monitor.
 #include <CLI/CLI.hpp>
-
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -46,8 +45,9 @@ void add_dds_options(CLI::App* app, dds::DdsOptions& o) {
 }
 
 void add_source_options(CLI::App* app, SourceChoice& s) {
-  auto* scenario = app->add_option("--scenario", s.scenario_file, "scenario YAML (default: the built-in scenario)")
-                       ->check(CLI::ExistingFile);
+  auto* scenario =
+      app->add_option("--scenario", s.scenario_file, "scenario YAML (default: the built-in scenario)")
+          ->check(CLI::ExistingFile);
   auto* replay = app->add_option("--replay", s.replay_dir, "replay a recording in the common CSV layout")
                      ->check(CLI::ExistingDirectory);
   scenario->excludes(replay);
@@ -73,8 +73,10 @@ void add_decoder_options(CLI::App* app, TofDecoderConfig& o, double& max_age_ms)
   app->add_option("--min-range-m", o.min_range_m, "shortest plausible range")->check(kNonNegative);
   app->add_option("--max-range-m", o.max_range_m, "longest plausible range")->check(kPositive);
   app->add_option("--range-sigma-m", o.range_sigma_m, "standard deviation of a range")->check(kPositive);
-  app->add_option("--range-scale", o.range_scale, "ranging calibration: range = c * tof / scale")->check(kPositive);
-  app->add_option("--max-age-ms", max_age_ms, "a TOF fired this long before the newest is stale")->check(kPositive);
+  app->add_option("--range-scale", o.range_scale, "ranging calibration: range = c * tof / scale")
+      ->check(kPositive);
+  app->add_option("--max-age-ms", max_age_ms, "a TOF fired this long before the newest is stale")
+      ->check(kPositive);
 }
 
 // with_robot_filter / with_circle: false where --robot names the simulated robot and the source
@@ -85,9 +87,11 @@ void add_localizer_options(CLI::App* app, LocalizerSettings& o, bool standalone)
   app->add_option("--param", o.parameters, "estimator parameter NAME=VALUE (repeatable)");
   if (!standalone) return;
   app->add_option("--robot", o.robot, "serve only this robot id (default: every robot)");
-  app->add_option("--receiver-radius-m", o.receiver_radius_m, "without --receivers: receivers on a circle of this radius")
+  app->add_option("--receiver-radius-m", o.receiver_radius_m,
+                  "without --receivers: receivers on a circle of this radius")
       ->check(kPositive);
-  app->add_option("--receiver-count", o.receiver_count, "without --receivers: number of receivers on the circle")
+  app->add_option("--receiver-count", o.receiver_count,
+                  "without --receivers: number of receivers on the circle")
       ->check(CLI::Range(1, 16));
   app->add_option("--receiver-height-m", o.receiver_height_m, "receivers' height above the floor");
 }
@@ -118,7 +122,8 @@ int run(int argc, char** argv) {
   std::string truth_file, estimate_file, beacons_file;
   double max_truth_gap_s = 0.5;
 
-  auto* gateway = app.add_subcommand("gateway", "beacon-gateway: publish the beacon map, TOFs, odometry and scans");
+  auto* gateway =
+      app.add_subcommand("gateway", "beacon-gateway: publish the beacon map, TOFs, odometry and scans");
   add_dds_options(gateway, dds_options);
   add_source_options(gateway, source_choice);
   add_gateway_options(gateway, gateway_options, seed);
@@ -127,20 +132,23 @@ int run(int argc, char** argv) {
   add_dds_options(decoder, dds_options);
   add_decoder_options(decoder, decoder_config, max_age_ms);
 
-  auto* localizer = app.add_subcommand("localizer", "localizer: odometry + ranges -> pose, one estimator plugin");
+  auto* localizer =
+      app.add_subcommand("localizer", "localizer: odometry + ranges -> pose, one estimator plugin");
   add_dds_options(localizer, dds_options);
   add_localizer_options(localizer, localizer_settings, true);
   localizer->add_flag("--list-estimators", list_estimators, "print the estimators and exit");
 
-  auto* demo = app.add_subcommand("demo", "the whole pipeline in one process on the built-in scenario, in real time");
+  auto* demo =
+      app.add_subcommand("demo", "the whole pipeline in one process on the built-in scenario, in real time");
   add_dds_options(demo, dds_options);
   add_gateway_options(demo, gateway_options, seed);
   add_localizer_options(demo, localizer_settings, false);
   demo->add_option("--out", out_dir, "write truth, estimates, metrics and plots into this directory");
 
   auto* run_cmd = app.add_subcommand(
-      "run", "gateway, decoder and localizer over DDS on a scenario or a recording, as fast as they go; "
-             "writes truth.csv, estimate.csv, metrics.json and plots");
+      "run",
+      "gateway, decoder and localizer over DDS on a scenario or a recording, as fast as they go; "
+      "writes truth.csv, estimate.csv, metrics.json and plots");
   add_dds_options(run_cmd, dds_options);
   add_source_options(run_cmd, source_choice);
   add_gateway_options(run_cmd, gateway_options, seed);
@@ -149,14 +157,22 @@ int run(int argc, char** argv) {
   run_cmd->add_option("--out", out_dir, "output directory")->required();
   run_cmd->add_flag("--processes", processes, "one process per participant (needs --speed)");
 
-  auto* eval = app.add_subcommand("eval", "score an estimate CSV against a truth CSV: metrics.json and plots");
-  eval->add_option("--truth", truth_file, "truth CSV (stamp_ns,x_m,y_m,yaw_rad)")->required()->check(CLI::ExistingFile);
-  eval->add_option("--estimate", estimate_file, "estimate CSV written by run or demo")->required()->check(CLI::ExistingFile);
+  auto* eval =
+      app.add_subcommand("eval", "score an estimate CSV against a truth CSV: metrics.json and plots");
+  eval->add_option("--truth", truth_file, "truth CSV (stamp_ns,x_m,y_m,yaw_rad)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  eval->add_option("--estimate", estimate_file, "estimate CSV written by run or demo")
+      ->required()
+      ->check(CLI::ExistingFile);
   eval->add_option("--out", out_dir, "output directory")->required();
-  eval->add_option("--beacons", beacons_file, "beacons CSV to draw (beacon_id,x_m,y_m,z_m)")->check(CLI::ExistingFile);
-  eval->add_option("--max-truth-gap-s", max_truth_gap_s, "interpolate truth over gaps up to this long")->check(kPositive);
+  eval->add_option("--beacons", beacons_file, "beacons CSV to draw (beacon_id,x_m,y_m,z_m)")
+      ->check(CLI::ExistingFile);
+  eval->add_option("--max-truth-gap-s", max_truth_gap_s, "interpolate truth over gaps up to this long")
+      ->check(kPositive);
 
-  auto* monitor = app.add_subcommand("monitor", "print the poses on the bus each second; with --truth, the accuracy at the end");
+  auto* monitor = app.add_subcommand(
+      "monitor", "print the poses on the bus each second; with --truth, the accuracy at the end");
   add_dds_options(monitor, dds_options);
   monitor->add_option("--duration-s", monitor_duration_s, "stop after this many seconds (0: until stopped)")
       ->check(kNonNegative);
@@ -192,7 +208,8 @@ int run(int argc, char** argv) {
         return 0;
       }
       LocalizerParticipant participant(
-          dds_options, LocalizerCore(localizer_settings.estimator, localizer_settings.config(), localizer_settings.robot));
+          dds_options,
+          LocalizerCore(localizer_settings.estimator, localizer_settings.config(), localizer_settings.robot));
       run_until_stopped();
       return 0;
     }
@@ -227,7 +244,8 @@ int run(int argc, char** argv) {
       print_diagnostics(diagnostics.latest(), std::cout);
       if (!truth_file.empty()) {
         const PoseRunSummary s = summarize(poses, load_truth_csv(truth_file));
-        std::printf("poses: %zu at %.1f Hz; %s\n", s.poses, s.pose_rate_hz, format_metrics(s.metrics).c_str());
+        std::printf("poses: %zu at %.1f Hz; %s\n", s.poses, s.pose_rate_hz,
+                    format_metrics(s.metrics).c_str());
       }
       return 0;
     }
@@ -245,11 +263,14 @@ int run(int argc, char** argv) {
         if (demo->count("--duration-s") == 0) o.gateway.duration_s = 20.0;
         o.print_poses = true;
       } else {
-        if (run_cmd->count("--speed") == 0) o.gateway.speed = processes ? 10.0 : 0.0;  // 0: as fast as it goes
-        if (run_cmd->count("--duration-s") == 0 && source.scenario) o.gateway.duration_s = source.scenario->duration_s;
+        if (run_cmd->count("--speed") == 0)
+          o.gateway.speed = processes ? 10.0 : 0.0;  // 0: as fast as it goes
+        if (run_cmd->count("--duration-s") == 0 && source.scenario)
+          o.gateway.duration_s = source.scenario->duration_s;
         o.print_progress = true;
       }
-      if (!out_dir.empty() && o.gateway.truth_csv.empty() && !processes) o.gateway.truth_csv = out_dir + "/truth.csv";
+      if (!out_dir.empty() && o.gateway.truth_csv.empty() && !processes)
+        o.gateway.truth_csv = out_dir + "/truth.csv";
       if (run_cmd->parsed()) {
         o.gateway.wall_clock_stamps = false;  // the same seed gives byte-identical files
         if (!processes) o.gateway.record_dir = out_dir;
@@ -260,7 +281,9 @@ int run(int argc, char** argv) {
       const PipelineResult r = run_pipeline(o, std::move(source), self.string());
       std::cout << r.diagnostics;
       std::printf("poses: %zu at %.1f Hz; %s\n", r.poses, r.pose_rate_hz, format_metrics(r.metrics).c_str());
-      if (!out_dir.empty()) std::cout << "wrote " << out_dir << "/{truth,estimate,beacons}.csv, metrics.json, trajectory.svg, error.svg\n";
+      if (!out_dir.empty())
+        std::cout << "wrote " << out_dir
+                  << "/{truth,estimate,beacons}.csv, metrics.json, trajectory.svg, error.svg\n";
       if (r.metrics.samples == 0) {
         std::cerr << "beaconloc: no pose was estimated\n";
         return 1;

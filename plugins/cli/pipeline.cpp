@@ -39,7 +39,8 @@ constexpr std::uint64_t kMaxTofLead = 8;
 
 class ChildProcess {
  public:
-  ChildProcess(const std::string& exe, const std::vector<std::string>& args, const std::string& log) : log_(log) {
+  ChildProcess(const std::string& exe, const std::vector<std::string>& args, const std::string& log)
+      : log_(log) {
     std::vector<std::string> argv{exe};
     argv.insert(argv.end(), args.begin(), args.end());
     std::vector<char*> c_argv;
@@ -47,7 +48,8 @@ class ChildProcess {
     c_argv.push_back(nullptr);
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
     posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
     const int rc = posix_spawn(&pid_, exe.c_str(), &actions, nullptr, c_argv.data(), environ);
     posix_spawn_file_actions_destroy(&actions);
@@ -117,10 +119,12 @@ void print_pose_line(double t_s, const PoseRecorder& recorder) {
 
 // Scores and writes the outputs shared by both modes.
 PipelineResult finish(const PipelineOptions& o, const LoadedSource& source, const BeaconMap& beacons,
-                      const std::vector<RecordedPose>& poses, const TruthTrack& truth, const std::string& diagnostics) {
+                      const std::vector<RecordedPose>& poses, const TruthTrack& truth,
+                      const std::string& diagnostics) {
   PipelineResult r;
   EvaluationOptions eval;
-  if (!poses.empty() && o.score_from_ns > 0) eval.score_from_ns = poses.front().row.estimate.stamp_ns + o.score_from_ns;
+  if (!poses.empty() && o.score_from_ns > 0)
+    eval.score_from_ns = poses.front().row.estimate.stamp_ns + o.score_from_ns;
   const PoseRunSummary s = summarize(poses, truth, eval);
   r.poses = s.poses;
   r.pose_rate_hz = s.pose_rate_hz;
@@ -129,7 +133,7 @@ PipelineResult finish(const PipelineOptions& o, const LoadedSource& source, cons
   if (!o.out_dir.empty()) {
     const auto rows = rows_of(poses);
     write_estimates_csv(o.out_dir + "/estimate.csv", rows);
-    write_beacons_csv(o.out_dir + "/beacons.csv", beacons);
+    write_beacon_map_csv(o.out_dir + "/beacons.csv", beacons);
     write_metrics_json(o.out_dir + "/metrics.json", r.metrics, o.localizer.estimator, source.label);
     const std::string title = source.label + ", " + o.localizer.estimator;
     write_trajectory_svg(o.out_dir + "/trajectory.svg", title, truth, rows, beacons,
@@ -185,8 +189,9 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
     }
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (o.print_progress && wall_s >= next_progress_s) {
-      std::printf("run: %.1f of %.1f s of data (%.0f%%), %zu poses\n", gateway->elapsed_s(), gateway->total_s(),
-                  100.0 * gateway->elapsed_s() / std::max(gateway->total_s(), 1e-9), recorder.count());
+      std::printf("run: %.1f of %.1f s of data (%.0f%%), %zu poses\n", gateway->elapsed_s(),
+                  gateway->total_s(), 100.0 * gateway->elapsed_s() / std::max(gateway->total_s(), 1e-9),
+                  recorder.count());
       std::fflush(stdout);
       next_progress_s += 2.0;
     }
@@ -202,7 +207,8 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
   }
   std::this_thread::sleep_for(100ms);
   if (stalls) {
-    std::printf("run: the gateway waited for a lost sample %llu time(s)\n", static_cast<unsigned long long>(stalls));
+    std::printf("run: the gateway waited for a lost sample %llu time(s)\n",
+                static_cast<unsigned long long>(stalls));
   }
   gateway->publish_diagnostics();
   decoder.publish_diagnostics();
@@ -215,7 +221,8 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
 }
 
 std::vector<std::string> dds_arguments(const dds::DdsOptions& d) {
-  std::vector<std::string> a{"--domain", std::to_string(d.domain_id), "--participant-profile", d.participant_profile};
+  std::vector<std::string> a{"--domain", std::to_string(d.domain_id), "--participant-profile",
+                             d.participant_profile};
   for (const auto& f : d.extra_qos_files) {
     a.push_back("--qos");
     a.push_back(f);
@@ -230,9 +237,11 @@ std::string number(double v) {
 }
 
 PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, const std::string& exe) {
-  if (o.out_dir.empty()) throw std::invalid_argument("--processes needs --out (the participants' logs go there)");
+  if (o.out_dir.empty())
+    throw std::invalid_argument("--processes needs --out (the participants' logs go there)");
   if (!(o.gateway.speed > 0.0)) {
-    throw std::invalid_argument("--processes needs --speed > 0: separate processes cannot hold the gateway back");
+    throw std::invalid_argument(
+        "--processes needs --speed > 0: separate processes cannot hold the gateway back");
   }
   const BeaconMap beacons = source.source->beacon_map();
   const ReceiverArray receivers = source.source->receivers();
@@ -252,15 +261,17 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
   }
   auto gateway_args = std::vector<std::string>{"gateway"};
   for (const auto& a : dds_arguments(o.dds)) gateway_args.push_back(a);
-  for (const auto& a : std::vector<std::string>{"--robot", o.gateway.robot_id, "--speed", number(o.gateway.speed),
-                                                "--seed", std::to_string(o.gateway.seed), "--duration-s",
-                                                number(o.gateway.duration_s), "--truth-out", o.out_dir + "/truth.csv"}) {
+  for (const auto& a :
+       std::vector<std::string>{"--robot", o.gateway.robot_id, "--speed", number(o.gateway.speed), "--seed",
+                                std::to_string(o.gateway.seed), "--duration-s", number(o.gateway.duration_s),
+                                "--truth-out", o.out_dir + "/truth.csv"}) {
     gateway_args.push_back(a);
   }
   if (!source.choice.replay_dir.empty()) {
-    for (const auto& a : std::vector<std::string>{
-             "--replay", source.choice.replay_dir, "--replay-wheel-base-m", number(source.choice.replay.wheel_base_m),
-             "--replay-odometry-k-v", number(source.choice.replay.odometry_k_v_m)}) {
+    for (const auto& a :
+         std::vector<std::string>{"--replay", source.choice.replay_dir, "--replay-wheel-base-m",
+                                  number(source.choice.replay.wheel_base_m), "--replay-odometry-k-v",
+                                  number(source.choice.replay.odometry_k_v_m)}) {
       gateway_args.push_back(a);
     }
   } else if (!source.choice.scenario_file.empty()) {
@@ -273,14 +284,15 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
   std::this_thread::sleep_for(1s);  // their readers exist before the gateway writes
   ChildProcess gateway(exe, gateway_args, o.out_dir + "/gateway.log");
   const auto start = std::chrono::steady_clock::now();
-  const double total_s = o.gateway.duration_s > 0.0 ? o.gateway.duration_s
-                                                     : ns_to_s(source.source->last_stamp_ns() - source.source->first_stamp_ns());
+  const double total_s = o.gateway.duration_s > 0.0
+                             ? o.gateway.duration_s
+                             : ns_to_s(source.source->last_stamp_ns() - source.source->first_stamp_ns());
   double next_progress_s = 2.0;
   while (!gateway.done() && !dds::wait_for_stop(100ms)) {
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (o.print_progress && wall_s >= next_progress_s) {
-      std::printf("run: ~%.0f of %.1f s of data, %zu poses\n", std::min(wall_s * o.gateway.speed, total_s), total_s,
-                  recorder.count());
+      std::printf("run: ~%.0f of %.1f s of data, %zu poses\n", std::min(wall_s * o.gateway.speed, total_s),
+                  total_s, recorder.count());
       std::fflush(stdout);
       next_progress_s += 2.0;
     }
@@ -291,16 +303,17 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
   localizer.terminate();
   const int decoder_code = decoder.wait(15s), localizer_code = localizer.wait(15s);
   if (gateway_code != 0 || decoder_code != 0 || localizer_code != 0) {
-    throw std::runtime_error("a participant failed (exit codes gateway " + std::to_string(gateway_code) + ", decoder " +
-                             std::to_string(decoder_code) + ", localizer " + std::to_string(localizer_code) +
-                             "); logs in " + o.out_dir);
+    throw std::runtime_error("a participant failed (exit codes gateway " + std::to_string(gateway_code) +
+                             ", decoder " + std::to_string(decoder_code) + ", localizer " +
+                             std::to_string(localizer_code) + "); logs in " + o.out_dir);
   }
   std::ostringstream diag;
   print_diagnostics(diagnostics.latest(), diag);
   return finish(o, source, beacons, recorder.poses(), load_truth_csv(o.out_dir + "/truth.csv"), diag.str());
 }
 
-std::vector<std::pair<std::string, std::string>> split_pairs(const std::string& text, char outer, char inner) {
+std::vector<std::pair<std::string, std::string>> split_pairs(const std::string& text, char outer,
+                                                             char inner) {
   std::vector<std::pair<std::string, std::string>> out;
   std::stringstream ss(text);
   std::string item;
@@ -329,7 +342,8 @@ LoadedSource load_source(const SourceChoice& choice, std::optional<std::uint64_t
   out.choice = choice;
   if (!choice.replay_dir.empty()) {
     auto replay = std::make_unique<ReplaySource>(choice.replay_dir, choice.replay);
-    for (const auto& problem : replay->load_problems()) std::fprintf(stderr, "replay: refused %s\n", problem.c_str());
+    for (const auto& problem : replay->load_problems())
+      std::fprintf(stderr, "replay: refused %s\n", problem.c_str());
     for (const auto& note : replay->load_notes()) std::fprintf(stderr, "replay: note: %s\n", note.c_str());
     out.label = "replay " + std::filesystem::path(choice.replay_dir).filename().string();
     if (out.label == "replay ") out.label = "replay " + choice.replay_dir;
@@ -350,7 +364,8 @@ EstimatorConfig LocalizerSettings::config(const std::optional<ReceiverArray>& fa
   EstimatorConfig c;
   if (!receivers.empty()) {
     for (const auto& [x, y] : split_pairs(receivers, ',', ':')) {
-      c.receivers.receivers_base_m.emplace_back(parse_double(x, "--receivers"), parse_double(y, "--receivers"));
+      c.receivers.receivers_base_m.emplace_back(parse_double(x, "--receivers"),
+                                                parse_double(y, "--receivers"));
     }
     c.receivers.receiver_height_m = receiver_height_m;
   } else if (fallback) {
@@ -361,7 +376,8 @@ EstimatorConfig LocalizerSettings::config(const std::optional<ReceiverArray>& fa
   }
   for (const auto& p : parameters) {
     const auto eq = p.find('=');
-    if (eq == std::string::npos || eq == 0) throw std::invalid_argument("--param '" + p + "' is not NAME=VALUE");
+    if (eq == std::string::npos || eq == 0)
+      throw std::invalid_argument("--param '" + p + "' is not NAME=VALUE");
     c.parameters[p.substr(0, eq)] = parse_double(p.substr(eq + 1), "--param '" + p + "'");
   }
   return c;
@@ -369,7 +385,8 @@ EstimatorConfig LocalizerSettings::config(const std::optional<ReceiverArray>& fa
 
 std::vector<std::string> LocalizerSettings::arguments(const std::optional<ReceiverArray>& fallback) const {
   const EstimatorConfig c = config(fallback);
-  std::vector<std::string> a{"--estimator", estimator, "--receivers", join_receivers(c.receivers),
+  std::vector<std::string> a{"--estimator",         estimator,
+                             "--receivers",         join_receivers(c.receivers),
                              "--receiver-height-m", number(c.receivers.receiver_height_m)};
   if (!robot.empty()) {
     a.push_back("--robot");
@@ -382,17 +399,18 @@ std::vector<std::string> LocalizerSettings::arguments(const std::optional<Receiv
   return a;
 }
 
-PipelineResult run_pipeline(const PipelineOptions& options, LoadedSource source, const std::string& self_exe) {
+PipelineResult run_pipeline(const PipelineOptions& options, LoadedSource source,
+                            const std::string& self_exe) {
   if (!options.out_dir.empty()) std::filesystem::create_directories(options.out_dir);
   return options.processes ? run_in_processes(options, std::move(source), self_exe)
                            : run_in_one_process(options, std::move(source));
 }
 
-Metrics evaluate_files(const std::string& truth_csv, const std::string& estimate_csv, const std::string& out_dir,
-                       const std::string& beacons_csv, double max_truth_gap_s) {
+Metrics evaluate_files(const std::string& truth_csv, const std::string& estimate_csv,
+                       const std::string& out_dir, const std::string& beacons_csv, double max_truth_gap_s) {
   const TruthTrack truth = load_truth_csv(truth_csv);
   const auto rows = load_estimates_csv(estimate_csv);
-  const BeaconMap beacons = beacons_csv.empty() ? BeaconMap() : load_beacons_csv(beacons_csv);
+  const BeaconMap beacons = beacons_csv.empty() ? BeaconMap() : load_beacon_map_csv(beacons_csv);
   EvaluationOptions eval;
   eval.max_truth_gap_ns = s_to_ns(max_truth_gap_s);
   const Metrics m = evaluate(truth, rows, eval);
@@ -407,14 +425,15 @@ Metrics evaluate_files(const std::string& truth_csv, const std::string& estimate
 
 std::string format_metrics(const Metrics& m) {
   char line[512];
-  std::snprintf(line, sizeof line,
-                "against ground truth (%zu poses): position RMS %.3f m, mean %.3f m, max %.3f m; heading RMS %s; "
-                "E_S mean %s; NEES in 95%% band %.2f",
-                m.samples, m.position_rms_m, m.position_mean_m, m.position_max_m,
-                m.heading_rms_deg ? (std::to_string(*m.heading_rms_deg).substr(0, 5) + " deg").c_str() : "n/a",
-                m.significant_points_mean_m ? (std::to_string(*m.significant_points_mean_m).substr(0, 5) + " m").c_str()
-                                            : "n/a",
-                m.nees_in_band_fraction);
+  std::snprintf(
+      line, sizeof line,
+      "against ground truth (%zu poses): position RMS %.3f m, mean %.3f m, max %.3f m; heading RMS %s; "
+      "E_S mean %s; NEES in 95%% band %.2f",
+      m.samples, m.position_rms_m, m.position_mean_m, m.position_max_m,
+      m.heading_rms_deg ? (std::to_string(*m.heading_rms_deg).substr(0, 5) + " deg").c_str() : "n/a",
+      m.significant_points_mean_m ? (std::to_string(*m.significant_points_mean_m).substr(0, 5) + " m").c_str()
+                                  : "n/a",
+      m.nees_in_band_fraction);
   return line;
 }
 

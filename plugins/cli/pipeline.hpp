@@ -37,7 +37,7 @@ LoadedSource load_source(const SourceChoice& choice, std::optional<std::uint64_t
 
 struct LocalizerSettings {
   std::string estimator = "range_ekf";
-  std::string robot;  // empty: every robot
+  std::string robot;                    // empty: every robot
   std::vector<std::string> parameters;  // NAME=VALUE
   // Receivers in the robot frame, "x:y,x:y,...": empty for a circle of receiver_count at
   // receiver_radius_m (the localizer alone) or the source's own receivers (demo, run).
@@ -57,11 +57,11 @@ struct PipelineOptions {
   GatewayOptions gateway;
   TofDecoderConfig decoder;
   LocalizerSettings localizer;
-  std::string out_dir;            // outputs written here when not empty
-  bool processes = false;         // one process per participant
-  bool print_poses = false;       // a pose line each second (demo)
-  bool print_progress = false;    // a progress line every 2 s (run)
-  StampNs score_from_ns = 0;      // settle time not scored, from the first pose
+  std::string out_dir;          // outputs written here when not empty
+  bool processes = false;       // one process per participant
+  bool print_poses = false;     // a pose line each second (demo)
+  bool print_progress = false;  // a progress line every 2 s (run)
+  StampNs score_from_ns = 0;    // settle time not scored, from the first pose
 };
 
 struct PipelineResult {
@@ -76,8 +76,8 @@ struct PipelineResult {
 PipelineResult run_pipeline(const PipelineOptions& options, LoadedSource source, const std::string& self_exe);
 
 // `beaconloc eval`: metrics.json, trajectory.svg and error.svg from a truth and an estimate CSV.
-Metrics evaluate_files(const std::string& truth_csv, const std::string& estimate_csv, const std::string& out_dir,
-                       const std::string& beacons_csv, double max_truth_gap_s);
+Metrics evaluate_files(const std::string& truth_csv, const std::string& estimate_csv,
+                       const std::string& out_dir, const std::string& beacons_csv, double max_truth_gap_s);
 
 std::string format_metrics(const Metrics& m);
 

@@ -12,8 +12,12 @@ DecoderParticipant::DecoderParticipant(const dds::DdsOptions& dds, TofDecoderCon
       participant_(dds, "beaconloc.decoder"),
       range_writer_(participant_.writer<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic)) {
   participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [this](const msg::BeaconMap& m) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    decoder_.set_beacon_map(dds::from_msg(m));
+    std::vector<DecodedRange> held;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      held = decoder_.set_beacon_map(dds::from_msg(m));
+    }
+    for (const auto& range : held) publish(range);
   });
   participant_.subscribe<msg::RawTofPubSubType>(
       dds::kRawTofTopic, [this](const msg::RawTof& m) { on_raw_tof(m); }, &deadline_misses_);
@@ -32,13 +36,13 @@ void DecoderParticipant::on_raw_tof(const msg::RawTof& m) {
     std::lock_guard<std::mutex> lock(mutex_);
     outcome = decoder_.decode(m.robot_id(), dds::from_msg(m));
   }
-  if (!outcome.range) {
-    ++tofs_processed_;
-    return;
-  }
-  const DecodedRange& d = *outcome.range;
+  if (outcome.range) publish(*outcome.range);
+  ++tofs_processed_;  // after the range is written: a throttle never sees the TOF done, the range not
+}
+
+void DecoderParticipant::publish(const DecodedRange& d) {
   msg::BeaconRange out;
-  out.robot_id(m.robot_id());
+  out.robot_id(d.robot_id);
   out.beacon_id(d.range.beacon_id);
   out.receiver_id(d.range.receiver_id);
   out.stamp_ns(d.range.stamp_ns);
@@ -48,8 +52,7 @@ void DecoderParticipant::on_raw_tof(const msg::RawTof& m) {
   out.association(d.associated ? msg::RANGE_ASSOCIATION_BY_ID : msg::RANGE_ASSOCIATION_UNASSOCIATED);
   out.source_sequence_number(d.source_sequence_number);
   range_writer_->write(&out);
-  ++ranges_written_;  // before tofs_processed_: a throttle never sees the TOF done, the range not sent
-  ++tofs_processed_;
+  ++ranges_written_;
 }
 
 msg::Diagnostics DecoderParticipant::diagnostics_snapshot() {

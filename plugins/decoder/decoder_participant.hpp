@@ -28,6 +28,7 @@ class DecoderParticipant {
  private:
   msg::Diagnostics diagnostics_snapshot();
   void on_raw_tof(const msg::RawTof& tof);
+  void publish(const DecodedRange& range);
 
   std::mutex mutex_;
   TofDecoder decoder_;

@@ -30,6 +30,11 @@ const char* to_string(TofRejection r) {
   return "unknown_reason";
 }
 
+// Seed 000, Section II-A: distance = c(T) * TOF, with the ranging system's calibration.
+double TofDecoder::range_of(const RawTofSample& tof) const {
+  return speed_of_sound_mps(tof.beacon_temperature_c) * tof.tof_s / config_.range_scale;
+}
+
 DecodeOutcome TofDecoder::reject(TofRejection r) {
   counts_.reject(to_string(r));
   DecodeOutcome out;
@@ -41,7 +46,8 @@ TofDecoder::TofDecoder(TofDecoderConfig config) : config_(config) {
   if (!(config_.range_scale > 0.0) || !std::isfinite(config_.range_scale)) {
     throw std::invalid_argument("range_scale must be a positive number");
   }
-  if (!(config_.max_range_m > config_.min_range_m)) throw std::invalid_argument("max_range_m must exceed min_range_m");
+  if (!(config_.max_range_m > config_.min_range_m))
+    throw std::invalid_argument("max_range_m must exceed min_range_m");
 }
 
 DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample& tof) {
@@ -51,15 +57,43 @@ DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample
   if (!std::isfinite(t_c) || t_c < config_.min_temperature_c || t_c > config_.max_temperature_c) {
     return reject(TofRejection::kBadTemperature);
   }
-  const double range_m = speed_of_sound_mps(t_c) * tof.tof_s / config_.range_scale;
+  const double range_m = range_of(tof);
   if (range_m < config_.min_range_m || range_m > config_.max_range_m) {
     return reject(TofRejection::kOutOfRangeTof);
   }
-  const bool identified = tof.beacon_id != kBeaconUnidentified;
-  if (identified) {
-    if (map_.empty()) return reject(TofRejection::kNoBeaconMap);
-    if (!map_.find(tof.beacon_id)) return reject(TofRejection::kUnknownBeacon);
+  if (tof.beacon_id != kBeaconUnidentified && map_.empty()) {
+    // Hold it for the map; what ages out of the backlog, or overflows it, is refused.
+    while (!backlog_.empty() &&
+           (backlog_.size() >= kMaxBacklog ||
+            backlog_.front().second.fire_stamp_ns < tof.fire_stamp_ns - config_.max_age_ns)) {
+      backlog_.pop_front();
+      counts_.reject(to_string(TofRejection::kNoBeaconMap));
+    }
+    backlog_.emplace_back(robot_id, tof);
+    DecodeOutcome out;
+    out.deferred = true;
+    return out;
   }
+  return decode_with_map(robot_id, tof, range_m);
+}
+
+std::vector<DecodedRange> TofDecoder::set_beacon_map(const BeaconMap& map) {
+  map_ = map;
+  std::vector<DecodedRange> ranges;
+  if (map_.empty()) return ranges;
+  for (const auto& [robot_id, tof] : backlog_) {
+    const auto out = decode_with_map(robot_id, tof, range_of(tof));
+    if (out.range) ranges.push_back(*out.range);
+  }
+  backlog_.clear();
+  return ranges;
+}
+
+// The checks that need the beacon map, freshness and duplicates; then the range.
+DecodeOutcome TofDecoder::decode_with_map(const std::string& robot_id, const RawTofSample& tof,
+                                          double range_m) {
+  const bool identified = tof.beacon_id != kBeaconUnidentified;
+  if (identified && !map_.find(tof.beacon_id)) return reject(TofRejection::kUnknownBeacon);
 
   RobotState& robot = robots_[robot_id];
   if (robot.seen_any && tof.fire_stamp_ns < robot.newest_fire_stamp_ns - config_.max_age_ns) {
@@ -76,6 +110,7 @@ DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample
   robot.seen_any = true;
 
   DecodedRange out;
+  out.robot_id = robot_id;
   out.range.stamp_ns = tof.fire_stamp_ns + s_to_ns(tof.tof_s);  // arrival of the pulse
   out.range.beacon_id = tof.beacon_id;
   out.range.receiver_id = tof.receiver_id;

@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "beaconloc/core/beacon_map.hpp"
 #include "beaconloc/core/measurements.hpp"
@@ -40,6 +41,7 @@ struct TofDecoderConfig {
 };
 
 struct DecodedRange {
+  std::string robot_id;
   RangeMeasurement range;
   bool associated = true;  // false: anonymous pulse, for an estimator that associates
   float quality = 1.0f;
@@ -49,19 +51,26 @@ struct DecodedRange {
 struct DecodeOutcome {
   std::optional<DecodedRange> range;
   std::optional<TofRejection> rejection;
+  bool deferred = false;  // held until the beacon map arrives (set_beacon_map decodes it)
 };
 
 class TofDecoder {
  public:
   explicit TofDecoder(TofDecoderConfig config = {});  // throws std::invalid_argument
-  void set_beacon_map(const BeaconMap& map) { map_ = map; }
+  // TOFs of identified beacons that came before the map are held (up to kMaxBacklog, for
+  // max_age_ns) rather than refused: the map and the first TOFs travel on different topics and
+  // may arrive in either order. Setting the map decodes them; their ranges are returned.
+  std::vector<DecodedRange> set_beacon_map(const BeaconMap& map);
+  static constexpr std::size_t kMaxBacklog = 64;
   bool has_beacon_map() const { return !map_.empty(); }
   DecodeOutcome decode(const std::string& robot_id, const RawTofSample& tof);
   const RejectionCounter& counts() const { return counts_; }
   const TofDecoderConfig& config() const { return config_; }
 
  private:
+  double range_of(const RawTofSample& tof) const;
   DecodeOutcome reject(TofRejection r);
+  DecodeOutcome decode_with_map(const std::string& robot_id, const RawTofSample& tof, double range_m);
   struct RobotState {
     StampNs newest_fire_stamp_ns = 0;
     bool seen_any = false;
@@ -70,6 +79,7 @@ class TofDecoder {
   TofDecoderConfig config_;
   BeaconMap map_;
   std::map<std::string, RobotState> robots_;
+  std::deque<std::pair<std::string, RawTofSample>> backlog_;  // before the map
   RejectionCounter counts_;
 };
 

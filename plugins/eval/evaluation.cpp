@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "beaconloc/core/csv_reader.hpp"
 #include "beaconloc/core/pose_error.hpp"
 
 namespace beaconloc {
@@ -18,65 +19,52 @@ namespace {
 constexpr double kChi2Band2[2] = {0.0506, 7.3778};
 constexpr double kChi2Band3[2] = {0.2158, 9.3484};
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) out.push_back(cell);
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-
-double number(const std::string& cell, const std::string& where) {
-  errno = 0;
-  char* end = nullptr;
-  const double v = std::strtod(cell.c_str(), &end);
-  if (cell.empty() || errno != 0 || end != cell.c_str() + cell.size() || !std::isfinite(v)) {
-    throw std::runtime_error(where + ": '" + cell + "' is not a finite number");
-  }
-  return v;
-}
-
-StampNs stamp(const std::string& cell, const std::string& where) {
+StampNs stamp(const CsvReader& csv, const std::string& column) {
+  const std::string& cell = csv.cell(column);
   errno = 0;
   char* end = nullptr;
   const long long v = std::strtoll(cell.c_str(), &end, 10);
   if (cell.empty() || errno != 0 || end != cell.c_str() + cell.size()) {
-    throw std::runtime_error(where + ": '" + cell + "' is not an integer stamp in ns");
+    throw CsvError(csv.where() + ": " + column + " '" + cell + "' is not an integer stamp in ns");
   }
   return v;
 }
 
-std::ifstream open_with_header(const std::string& path, const std::string& header) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error("cannot read '" + path + "'");
-  std::string line;
-  std::getline(in, line);
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  if (line != header) throw std::runtime_error(path + ":1: expected the header " + header);
-  return in;
+double number(const CsvReader& csv, const std::string& column) {
+  double v = 0.0;
+  if (!parse_finite(csv.cell(column), v)) {
+    throw CsvError(csv.where() + ": " + column + " '" + csv.cell(column) + "' is not a finite number");
+  }
+  return v;
 }
 
-const char* kEstimateHeader =
-    "robot_id,stamp_ns,x_m,y_m,yaw_rad,cov_00,cov_01,cov_02,cov_10,cov_11,cov_12,cov_20,cov_21,cov_22,status,"
-    "estimator";
+void require_complete(const CsvReader& csv) {
+  if (!csv.complete()) throw CsvError(csv.where() + ": expected " + std::to_string(csv.width()) + " columns");
+}
+
+const std::vector<std::string> kEstimateColumns = {
+    "robot_id", "stamp_ns", "x_m",    "y_m",    "yaw_rad", "cov_00", "cov_01", "cov_02",
+    "cov_10",   "cov_11",   "cov_12", "cov_20", "cov_21",  "cov_22", "status", "estimator"};
 
 PoseStatus status_from(const std::string& s, const std::string& where) {
-  for (PoseStatus p : {PoseStatus::kInitializing, PoseStatus::kOk, PoseStatus::kDegraded, PoseStatus::kLost}) {
+  for (PoseStatus p :
+       {PoseStatus::kInitializing, PoseStatus::kOk, PoseStatus::kDegraded, PoseStatus::kLost}) {
     if (s == to_string(p)) return p;
   }
-  throw std::runtime_error(where + ": unknown status '" + s + "'");
+  throw CsvError(where + ": unknown status '" + s + "'");
 }
 
 }  // namespace
 
 const std::vector<Eigen::Vector2d>& significant_points_base_m() {
   // Seed 000, Section V (ERRATA: the fifth point is the mirror [-0.24, 0.2]).
-  static const std::vector<Eigen::Vector2d> points = {{0.2, 0.0}, {0.0, 0.2}, {0.0, -0.2}, {-0.24, -0.2}, {-0.24, 0.2}};
+  static const std::vector<Eigen::Vector2d> points = {
+      {0.2, 0.0}, {0.0, 0.2}, {0.0, -0.2}, {-0.24, -0.2}, {-0.24, 0.2}};
   return points;
 }
 
-Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estimates, const EvaluationOptions& options) {
+Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estimates,
+                 const EvaluationOptions& options) {
   Metrics m;
   bool all_have_yaw = true;
   std::vector<std::pair<const EstimateRow*, TruthSample>> scored;
@@ -142,7 +130,8 @@ std::vector<ErrorPoint> error_series(const TruthTrack& truth, const std::vector<
     const auto t = truth.at(row.estimate.stamp_ns, options.max_truth_gap_ns);
     if (!t) continue;
     const Pose2& est = row.estimate.pose_map_base;
-    ErrorPoint p{ns_to_s(row.estimate.stamp_ns - t0), (t->pose_map_base.head<2>() - est.head<2>()).norm(), {}};
+    ErrorPoint p{
+        ns_to_s(row.estimate.stamp_ns - t0), (t->pose_map_base.head<2>() - est.head<2>()).norm(), {}};
     if (t->has_yaw) p.heading_deg = wrap_angle_rad(t->pose_map_base.z() - est.z()) * 180.0 / M_PI;
     out.push_back(p);
   }
@@ -150,39 +139,32 @@ std::vector<ErrorPoint> error_series(const TruthTrack& truth, const std::vector<
 }
 
 TruthTrack load_truth_csv(const std::string& path) {
-  auto in = open_with_header(path, "stamp_ns,x_m,y_m,yaw_rad");
+  CsvReader csv(path, {"stamp_ns", "x_m", "y_m", "yaw_rad"});
   TruthTrack truth;
-  std::string line;
-  for (int n = 2; std::getline(in, line); ++n) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    const std::string where = path + ":" + std::to_string(n);
-    const auto c = split(line);
-    if (c.size() != 4) throw std::runtime_error(where + ": expected 4 columns");
-    const bool has_yaw = !c[3].empty();
-    truth.add(stamp(c[0], where), {number(c[1], where), number(c[2], where), has_yaw ? number(c[3], where) : 0.0},
-              has_yaw);
+  while (csv.next()) {
+    require_complete(csv);
+    const bool has_yaw = !csv.cell("yaw_rad").empty();
+    truth.add(stamp(csv, "stamp_ns"),
+              {number(csv, "x_m"), number(csv, "y_m"), has_yaw ? number(csv, "yaw_rad") : 0.0}, has_yaw);
   }
   return truth;
 }
 
 std::vector<EstimateRow> load_estimates_csv(const std::string& path) {
-  auto in = open_with_header(path, kEstimateHeader);
+  CsvReader csv(path, kEstimateColumns);
   std::vector<EstimateRow> rows;
-  std::string line;
-  for (int n = 2; std::getline(in, line); ++n) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    const std::string where = path + ":" + std::to_string(n);
-    const auto c = split(line);
-    if (c.size() != 16) throw std::runtime_error(where + ": expected 16 columns");
+  while (csv.next()) {
+    require_complete(csv);
     EstimateRow r;
-    r.robot_id = c[0];
-    r.estimate.stamp_ns = stamp(c[1], where);
-    r.estimate.pose_map_base = {number(c[2], where), number(c[3], where), number(c[4], where)};
-    for (int i = 0; i < 9; ++i) r.estimate.covariance(i / 3, i % 3) = number(c[5 + i], where);
-    r.estimate.status = status_from(c[14], where);
-    r.estimator = c[15];
+    r.robot_id = csv.cell("robot_id");
+    r.estimate.stamp_ns = stamp(csv, "stamp_ns");
+    r.estimate.pose_map_base = {number(csv, "x_m"), number(csv, "y_m"), number(csv, "yaw_rad")};
+    for (int i = 0; i < 9; ++i) {
+      r.estimate.covariance(i / 3, i % 3) =
+          number(csv, "cov_" + std::to_string(i / 3) + std::to_string(i % 3));
+    }
+    r.estimate.status = status_from(csv.cell("status"), csv.where());
+    r.estimator = csv.cell("estimator");
     rows.push_back(r);
   }
   return rows;
@@ -191,7 +173,8 @@ std::vector<EstimateRow> load_estimates_csv(const std::string& path) {
 void write_estimates_csv(const std::string& path, const std::vector<EstimateRow>& rows) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write '" + path + "'");
-  out << kEstimateHeader << '\n' << std::setprecision(12);
+  for (std::size_t i = 0; i < kEstimateColumns.size(); ++i) out << (i ? "," : "") << kEstimateColumns[i];
+  out << '\n' << std::setprecision(12);
   for (const auto& r : rows) {
     const auto& e = r.estimate;
     out << r.robot_id << ',' << e.stamp_ns << ',' << e.pose_map_base.x() << ',' << e.pose_map_base.y() << ','
@@ -217,7 +200,10 @@ void write_metrics_json(const std::string& path, const Metrics& m, const std::st
   auto optional = [](const std::optional<double>& v) {
     std::ostringstream s;
     s << std::setprecision(6);
-    if (v) s << *v; else s << "null";
+    if (v)
+      s << *v;
+    else
+      s << "null";
     return s.str();
   };
   out << std::setprecision(6) << "{\n"
@@ -234,33 +220,6 @@ void write_metrics_json(const std::string& path, const Metrics& m, const std::st
       << "  \"nees_dof\": " << m.nees_dof << "\n"
       << "}\n";
   if (!out.flush()) throw std::runtime_error("writing '" + path + "' failed");
-}
-
-void write_beacons_csv(const std::string& path, const BeaconMap& map) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write '" + path + "'");
-  out << "beacon_id,x_m,y_m,z_m\n" << std::setprecision(10);
-  for (const auto& b : map.beacons()) {
-    out << b.id << ',' << b.position_map_m.x() << ',' << b.position_map_m.y() << ',' << b.position_map_m.z() << '\n';
-  }
-  if (!out.flush()) throw std::runtime_error("writing '" + path + "' failed");
-}
-
-BeaconMap load_beacons_csv(const std::string& path) {
-  auto in = open_with_header(path, "beacon_id,x_m,y_m,z_m");
-  std::vector<Beacon> beacons;
-  std::string line;
-  for (int n = 2; std::getline(in, line); ++n) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    const std::string where = path + ":" + std::to_string(n);
-    const auto c = split(line);
-    if (c.size() != 4) throw std::runtime_error(where + ": expected 4 columns");
-    const double id = number(c[0], where);
-    if (id < 0 || id != std::floor(id) || id >= 4294967295.0) throw std::runtime_error(where + ": bad beacon id");
-    beacons.push_back({static_cast<std::uint32_t>(id), {number(c[1], where), number(c[2], where), number(c[3], where)}, 0});
-  }
-  return BeaconMap(beacons);
 }
 
 }  // namespace beaconloc

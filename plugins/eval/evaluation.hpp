@@ -28,7 +28,7 @@ struct EvaluationOptions {
 };
 
 struct Metrics {
-  std::size_t samples = 0;              // estimates scored (truth known at their stamp)
+  std::size_t samples = 0;  // estimates scored (truth known at their stamp)
   std::size_t samples_without_truth = 0;
   double position_rms_m = 0.0;
   double position_mean_m = 0.0;
@@ -57,13 +57,12 @@ std::vector<ErrorPoint> error_series(const TruthTrack& truth, const std::vector<
 
 // Files. Truth: stamp_ns,x_m,y_m,yaw_rad (yaw may be empty). Estimates:
 // robot_id,stamp_ns,x_m,y_m,yaw_rad,cov_00..cov_22 (row-major 3x3),status,estimator.
-// Loaders throw std::runtime_error naming the file and line of a malformed row.
+// Loaders throw CsvError (core/csv_reader.hpp) naming the file and line of a malformed row.
+// Beacon maps: load_beacon_map_csv / write_beacon_map_csv of core/csv_reader.hpp.
 TruthTrack load_truth_csv(const std::string& path);
 std::vector<EstimateRow> load_estimates_csv(const std::string& path);
 void write_estimates_csv(const std::string& path, const std::vector<EstimateRow>& rows);
 void write_metrics_json(const std::string& path, const Metrics& m, const std::string& estimator,
                         const std::string& source);
-void write_beacons_csv(const std::string& path, const BeaconMap& map);
-BeaconMap load_beacons_csv(const std::string& path);
 
 }  // namespace beaconloc

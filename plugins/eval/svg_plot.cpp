@@ -12,7 +12,7 @@ namespace {
 
 // Maps a data rectangle onto a pixel rectangle (y up in the data, down in SVG).
 struct Frame {
-  double x0, y0, x1, y1;     // data bounds
+  double x0, y0, x1, y1;            // data bounds
   double left, top, width, height;  // pixels
   double px(double x) const { return left + (x - x0) / (x1 - x0) * width; }
   double py(double y) const { return top + height - (y - y0) / (y1 - y0) * height; }
@@ -41,10 +41,14 @@ std::string tick(double v, double step) {
 std::string escape(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '&') out += "&amp;";
-    else out += c;
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else
+      out += c;
   }
   return out;
 }
@@ -59,13 +63,14 @@ void axes(std::ostream& out, const Frame& f, const std::string& x_label, const s
         << "' font-size='12' text-anchor='middle'>" << tick(x, sx) << "</text>\n";
   }
   for (double y = std::ceil(f.y0 / sy) * sy; y <= f.y1 + 1e-9; y += sy) {
-    out << "<line x1='" << f.left << "' y1='" << f.py(y) << "' x2='" << f.left + f.width << "' y2='" << f.py(y)
-        << "' stroke='#ddd'/><text x='" << f.left - 6 << "' y='" << f.py(y) + 4
+    out << "<line x1='" << f.left << "' y1='" << f.py(y) << "' x2='" << f.left + f.width << "' y2='"
+        << f.py(y) << "' stroke='#ddd'/><text x='" << f.left - 6 << "' y='" << f.py(y) + 4
         << "' font-size='12' text-anchor='end'>" << tick(y, sy) << "</text>\n";
   }
   out << "<text x='" << f.left + f.width / 2 << "' y='" << f.top + f.height + 34
       << "' font-size='13' text-anchor='middle'>" << escape(x_label) << "</text>\n"
-      << "<text x='" << f.left - 44 << "' y='" << f.top + f.height / 2 << "' font-size='13' text-anchor='middle' "
+      << "<text x='" << f.left - 44 << "' y='" << f.top + f.height / 2
+      << "' font-size='13' text-anchor='middle' "
       << "transform='rotate(-90 " << f.left - 44 << ' ' << f.top + f.height / 2 << ")'>" << escape(y_label)
       << "</text>\n";
 }
@@ -86,7 +91,8 @@ std::ofstream open_svg(const std::string& path, int width, int height, const std
   if (!out) throw std::runtime_error("cannot write '" + path + "'");
   out << "<svg xmlns='http://www.w3.org/2000/svg' width='" << width << "' height='" << height
       << "' font-family='sans-serif'>\n<rect width='100%' height='100%' fill='white'/>\n"
-      << "<text x='" << width / 2 << "' y='22' font-size='16' text-anchor='middle'>" << escape(title) << "</text>\n";
+      << "<text x='" << width / 2 << "' y='22' font-size='16' text-anchor='middle'>" << escape(title)
+      << "</text>\n";
   out.setf(std::ios::fixed);
   out.precision(2);
   return out;
@@ -149,9 +155,9 @@ void write_trajectory_svg(const std::string& path, const std::string& title, con
   polyline(out, f, estimate_xy, "#1f77d4", 1.3);
   for (const auto& b : beacons.beacons()) {
     const double x = f.px(b.position_map_m.x()), y = f.py(b.position_map_m.y());
-    out << "<polygon points='" << x << ',' << y - 7 << ' ' << x - 6 << ',' << y + 5 << ' ' << x + 6 << ',' << y + 5
-        << "' fill='#d62728'/><text x='" << x + 8 << "' y='" << y - 6 << "' font-size='11' fill='#d62728'>" << b.id
-        << "</text>\n";
+    out << "<polygon points='" << x << ',' << y - 7 << ' ' << x - 6 << ',' << y + 5 << ' ' << x + 6 << ','
+        << y + 5 << "' fill='#d62728'/><text x='" << x + 8 << "' y='" << y - 6
+        << "' font-size='11' fill='#d62728'>" << b.id << "</text>\n";
   }
   out << "<g font-size='12'><line x1='600' y1='652' x2='625' y2='652' stroke='#111' stroke-width='2'/>"
       << "<text x='630' y='656'>truth</text><line x1='680' y1='652' x2='705' y2='652' stroke='#1f77d4' "
@@ -160,7 +166,8 @@ void write_trajectory_svg(const std::string& path, const std::string& title, con
   close_svg(out, path);
 }
 
-void write_error_svg(const std::string& path, const std::string& title, const std::vector<ErrorPoint>& errors) {
+void write_error_svg(const std::string& path, const std::string& title,
+                     const std::vector<ErrorPoint>& errors) {
   auto out = open_svg(path, 860, 620, title);
   double t_max = 1.0, p_max = 0.01, h_max = 0.1;
   bool any_heading = false;
@@ -185,7 +192,8 @@ void write_error_svg(const std::string& path, const std::string& title, const st
     axes(out, fh, "time (s)", "heading error (deg)");
     polyline(out, fh, eh, "#2ca02c", 1.2);
   } else {
-    out << "<text x='450' y='440' font-size='14' text-anchor='middle'>no heading in the ground truth</text>\n";
+    out << "<text x='450' y='440' font-size='14' text-anchor='middle'>no heading in the ground "
+           "truth</text>\n";
   }
   close_svg(out, path);
 }

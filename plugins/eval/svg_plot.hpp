@@ -14,6 +14,7 @@ void write_trajectory_svg(const std::string& path, const std::string& title, con
                           const std::vector<EstimateRow>& estimates, const BeaconMap& beacons,
                           const std::optional<OccupancyGrid>& map = std::nullopt);
 
-void write_error_svg(const std::string& path, const std::string& title, const std::vector<ErrorPoint>& errors);
+void write_error_svg(const std::string& path, const std::string& title,
+                     const std::vector<ErrorPoint>& errors);
 
 }  // namespace beaconloc

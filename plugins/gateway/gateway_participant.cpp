@@ -12,7 +12,8 @@
 namespace beaconloc {
 
 GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOptions options,
-                                       std::unique_ptr<Source> source, TruthCallback on_truth, Throttle throttle)
+                                       std::unique_ptr<Source> source, TruthCallback on_truth,
+                                       Throttle throttle)
     : options_(std::move(options)),
       source_(std::move(source)),
       on_truth_(std::move(on_truth)),
@@ -38,8 +39,9 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
     record_tof_ << "fire_stamp_ns,beacon_id,receiver_id,tof_s,beacon_temperature_c,sequence_number,"
                    "true_beacon_id,echo\n"
                 << std::setprecision(12);
-    record_odometry_ << "stamp_ns,wheel_velocity_right_mps,wheel_velocity_left_mps,wheel_base_m,var_right,var_left\n"
-                     << std::setprecision(12);
+    record_odometry_
+        << "stamp_ns,wheel_velocity_right_mps,wheel_velocity_left_mps,wheel_base_m,var_right,var_left\n"
+        << std::setprecision(12);
   }
   const double source_s = ns_to_s(source_->last_stamp_ns() - source_->first_stamp_ns());
   total_s_ = options_.duration_s > 0.0 ? options_.duration_s : source_s;
@@ -47,10 +49,10 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
     std::lock_guard<std::mutex> lock(counts_mutex_);
     RejectionCounter counts = counts_;
     counts.add_rejections(source_->input_rejections(), "source.");
-    return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, 0,
-                                 counts.rejected_total() ? msg::PARTICIPANT_STATUS_DEGRADED
-                                                         : msg::PARTICIPANT_STATUS_OK,
-                                 source_->describe() + ", robot " + options_.robot_id);
+    return dds::make_diagnostics(
+        participant_.name(), dds::wall_clock_ns(), counts, 0,
+        counts.rejected_total() ? msg::PARTICIPANT_STATUS_DEGRADED : msg::PARTICIPANT_STATUS_OK,
+        source_->describe() + ", robot " + options_.robot_id);
   });
 }
 
@@ -64,7 +66,9 @@ bool GatewayParticipant::wait_for_readers(std::chrono::milliseconds timeout) con
   return dds::wait_for_matched_readers({tof_writer_, odometry_writer_}, timeout);
 }
 
-void GatewayParticipant::start() { thread_ = std::thread([this] { run(); }); }
+void GatewayParticipant::start() {
+  thread_ = std::thread([this] { run(); });
+}
 
 void GatewayParticipant::stop() {
   stop_ = true;
@@ -112,9 +116,10 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
       e.odometry.stamp_ns = stamp;
       if (record_odometry_.is_open()) {
         const auto& o = e.odometry;
-        record_odometry_ << o.stamp_ns << ',' << o.wheel_velocity_right_mps << ',' << o.wheel_velocity_left_mps << ','
-                         << o.wheel_base_m << ',' << o.wheel_velocity_covariance(0, 0) << ','
-                         << o.wheel_velocity_covariance(1, 1) << '\n';
+        record_odometry_ << o.stamp_ns << ',' << o.wheel_velocity_right_mps << ','
+                         << o.wheel_velocity_left_mps << ',' << o.wheel_base_m << ','
+                         << o.wheel_velocity_covariance(0, 0) << ',' << o.wheel_velocity_covariance(1, 1)
+                         << '\n';
       }
       auto m = dds::to_msg(options_.robot_id, e.odometry, odometry_sequence_++);
       count(odometry_writer_->write(&m));
@@ -137,7 +142,8 @@ void GatewayParticipant::run() {
   using clock = std::chrono::steady_clock;
   // Simulated stamps start at 0: offset them to the wall clock at start, so live consumers see
   // real times. A recording keeps its own clock.
-  const StampNs offset_ns = source_->relative_stamps() && options_.wall_clock_stamps ? dds::wall_clock_ns() : 0;
+  const StampNs offset_ns =
+      source_->relative_stamps() && options_.wall_clock_stamps ? dds::wall_clock_ns() : 0;
   auto beacon_map = dds::to_msg(source_->beacon_map(), options_.frame_id);
   count(map_writer_->write(&beacon_map));
 

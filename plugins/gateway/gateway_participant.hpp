@@ -24,7 +24,7 @@ struct GatewayOptions {
   double duration_s = 0.0;  // seconds of source time to run; 0 = the whole source / until stopped
   double speed = 1.0;       // source seconds per wall second; 0 = as fast as the throttle allows
   std::uint64_t seed = 1;
-  std::string truth_csv;    // ground truth written here when not empty
+  std::string truth_csv;  // ground truth written here when not empty
   // The samples written, as CSV (tof.csv, odometry.csv, with the simulator's hidden truth: who
   // fired, echo or not), when not empty.
   std::string record_dir;

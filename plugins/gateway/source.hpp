@@ -18,11 +18,11 @@ struct SourceEvent {
   Kind kind = Kind::kOdometry;
   StampNs stamp_ns = 0;  // odometry stamp, arrival of a pulse, scan or truth time
 
-  OdometrySample odometry;  // kOdometry
-  RawTofSample tof;         // kTof
+  OdometrySample odometry;                             // kOdometry
+  RawTofSample tof;                                    // kTof
   std::uint32_t true_beacon_id = kBeaconUnidentified;  // kTof: who fired, for evaluation only
   bool tof_is_echo = false;                            // kTof: simulated echo, for evaluation only
-  LaserScanSample scan;     // kLaserScan
+  LaserScanSample scan;                                // kLaserScan
 
   // Ground truth at stamp_ns: on kTruth events, and on the simulator's kOdometry events.
   bool has_truth = false;

@@ -7,11 +7,12 @@
 namespace beaconloc {
 
 PoseRecorder::PoseRecorder(const dds::DdsOptions& dds) : participant_(dds, "beaconloc.pose_recorder") {
-  participant_.subscribe<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic, [this](const msg::PoseEstimate& m) {
-    RecordedPose p{{m.robot_id(), dds::from_msg(m), m.estimator()}, std::chrono::steady_clock::now()};
-    std::lock_guard<std::mutex> lock(mutex_);
-    poses_.push_back(std::move(p));
-  });
+  participant_.subscribe<msg::PoseEstimatePubSubType>(
+      dds::kPoseEstimateTopic, [this](const msg::PoseEstimate& m) {
+        RecordedPose p{{m.robot_id(), dds::from_msg(m), m.estimator()}, std::chrono::steady_clock::now()};
+        std::lock_guard<std::mutex> lock(mutex_);
+        poses_.push_back(std::move(p));
+      });
 }
 
 PoseRecorder::~PoseRecorder() { participant_.close(); }
@@ -43,7 +44,8 @@ PoseRunSummary summarize(const std::vector<RecordedPose>& poses, const TruthTrac
   PoseRunSummary s;
   s.poses = poses.size();
   if (poses.size() >= 2) {
-    const double span_s = std::chrono::duration<double>(poses.back().received - poses.front().received).count();
+    const double span_s =
+        std::chrono::duration<double>(poses.back().received - poses.front().received).count();
     if (span_s > 0.0) s.pose_rate_hz = static_cast<double>(poses.size() - 1) / span_s;
   }
   s.metrics = evaluate(truth, rows_of(poses), options);

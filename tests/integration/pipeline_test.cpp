@@ -75,7 +75,8 @@ TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   for (const auto& p : poses) ASSERT_EQ(p.row.robot_id, "robot7");
   const auto truth = load_truth_csv(path("truth.csv"));
   const PoseRunSummary s = summarize(poses, truth);
-  const double stamp_span_s = ns_to_s(poses.back().row.estimate.stamp_ns - poses.front().row.estimate.stamp_ns);
+  const double stamp_span_s =
+      ns_to_s(poses.back().row.estimate.stamp_ns - poses.front().row.estimate.stamp_ns);
   std::printf(
       "multi-process pipeline: %zu poses over %.1f s of motion at %.1f Hz; position RMS %.3f m, "
       "max %.3f m; heading RMS %.2f deg\n",
@@ -112,7 +113,8 @@ TEST_F(Pipeline, LateJoiningLocalizerGetsTheMapAndLocalizes) {
   ASSERT_GT(poses.size(), 100u) << "localizer log:\n" << localizer.log();
   const auto truth = load_truth_csv(path("truth.csv"));
   const PoseRunSummary s = summarize(poses, truth);
-  const double stamp_span_s = ns_to_s(poses.back().row.estimate.stamp_ns - poses.front().row.estimate.stamp_ns);
+  const double stamp_span_s =
+      ns_to_s(poses.back().row.estimate.stamp_ns - poses.front().row.estimate.stamp_ns);
   std::printf("late-joining localizer: %zu poses over %.1f s at %.1f Hz; position RMS %.3f m\n", s.poses,
               stamp_span_s, s.pose_rate_hz, s.metrics.position_rms_m);
   // Started 5 s into a 20 s run: localizing within ~3 s of its start leaves >= 12 s of poses.

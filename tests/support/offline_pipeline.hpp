@@ -15,7 +15,7 @@
 namespace beaconloc::testing {
 
 inline std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed,
-                                           double duration_s) {
+                                         double duration_s) {
   sim::SimSource source(scenario, seed);
   std::vector<SourceEvent> events;
   source.advance(s_to_ns(duration_s), events);

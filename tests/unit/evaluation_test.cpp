@@ -1,11 +1,12 @@
 // Evaluation: the papers' metrics on tracks whose errors are known, files round-trip, plots.
+#include "evaluation.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
-#include "evaluation.hpp"
 #include "svg_plot.hpp"
 
 namespace beaconloc {
@@ -48,23 +49,27 @@ TEST(Evaluation, SignificantPointsWithoutTranslationAreTheRotationOfThePoints) {
   const double dphi = 5.0 * M_PI / 180.0;
   const Metrics m = evaluate(truth, shifted(truth, {0.0, 0.0, dphi}, Cov3::Identity()));
   double sum_sq = 0;
-  for (const auto& p : significant_points_base_m()) sum_sq += std::pow(2.0 * std::sin(dphi / 2.0) * p.norm(), 2);
+  for (const auto& p : significant_points_base_m())
+    sum_sq += std::pow(2.0 * std::sin(dphi / 2.0) * p.norm(), 2);
   EXPECT_NEAR(*m.significant_points_mean_m, std::sqrt(sum_sq / 5.0), 1e-12);
 }
 
 TEST(Evaluation, NeesBandTellsHonestFromOverconfidentCovariances) {
   const TruthTrack truth = circle_track(true);
   const Pose2 error(0.01, -0.01, 0.01);  // NEES = 3 with unit-variance 0.01^2 covariance: in the band
-  EXPECT_NEAR(evaluate(truth, shifted(truth, error, 1e-4 * Cov3::Identity())).nees_in_band_fraction, 1.0, 1e-12);
-  EXPECT_NEAR(evaluate(truth, shifted(truth, error, 1e-6 * Cov3::Identity())).nees_in_band_fraction, 0.0, 1e-12);
+  EXPECT_NEAR(evaluate(truth, shifted(truth, error, 1e-4 * Cov3::Identity())).nees_in_band_fraction, 1.0,
+              1e-12);
+  EXPECT_NEAR(evaluate(truth, shifted(truth, error, 1e-6 * Cov3::Identity())).nees_in_band_fraction, 0.0,
+              1e-12);
 }
 
 TEST(Evaluation, TruthWithoutHeadingScoresPositionOnlyAndInterpolates) {
   TruthTrack truth;
   truth.add(0, {0.0, 0.0, 0.0}, false);
   truth.add(200'000'000, {2.0, 0.0, 0.0}, false);
-  std::vector<EstimateRow> rows = {{"r", {100'000'000, {1.0, 0.1, 3.0}, Cov3::Identity(), PoseStatus::kOk}, "t"},
-                                   {"r", {900'000'000, {1.0, 0.0, 0.0}, Cov3::Identity(), PoseStatus::kOk}, "t"}};
+  std::vector<EstimateRow> rows = {
+      {"r", {100'000'000, {1.0, 0.1, 3.0}, Cov3::Identity(), PoseStatus::kOk}, "t"},
+      {"r", {900'000'000, {1.0, 0.0, 0.0}, Cov3::Identity(), PoseStatus::kOk}, "t"}};
   const Metrics m = evaluate(truth, rows);
   EXPECT_EQ(m.samples, 1u);
   EXPECT_EQ(m.samples_without_truth, 1u);  // past the end of the truth

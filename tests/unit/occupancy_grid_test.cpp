@@ -1,16 +1,16 @@
 // Ray casting on the occupancy grid against hand-made grids: exact to the cell boundary.
+#include "beaconloc/core/occupancy_grid.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "beaconloc/core/occupancy_grid.hpp"
 
 namespace beaconloc {
 namespace {
 
 TEST(OccupancyGrid, RayStopsAtTheFaceOfTheFirstOccupiedCell) {
   OccupancyGrid grid({0.0, 0.0}, 0.1, 50, 30);  // 5 m x 3 m
-  grid.set_occupied(40, 10, true);               // cell [4.0, 4.1) x [1.0, 1.1)
+  grid.set_occupied(40, 10, true);              // cell [4.0, 4.1) x [1.0, 1.1)
   // From (1.05, 1.05) along +x: hits the cell's left face at x = 4.0.
   EXPECT_NEAR(*grid.cast_ray({1.05, 1.05}, 0.0, 10.0), 2.95, 1e-9);
   // Along -x nothing: outside cells are free.
@@ -21,7 +21,7 @@ TEST(OccupancyGrid, RayStopsAtTheFaceOfTheFirstOccupiedCell) {
 
 TEST(OccupancyGrid, DiagonalRaysAndBorders) {
   OccupancyGrid grid({-1.0, -1.0}, 0.1, 20, 20);  // [-1, 1] x [-1, 1]
-  grid.fill_border();                              // cells at index 0 and 19
+  grid.fill_border();                             // cells at index 0 and 19
   // From the centre at 45 degrees: reaches the corner cell, whose face is at 0.9.
   EXPECT_NEAR(*grid.cast_ray({0.0, 0.0}, M_PI / 4, 10.0), 0.9 * std::sqrt(2.0), 1e-9);
   // Straight up from (0.05, 0.05): face at y = 0.9.

@@ -74,12 +74,13 @@ TEST(Replay, BadRowsAreRefusedAndCountedNotRepaired) {
   std::ofstream(dir + "/beacons.csv") << "beacon_id,x_m,y_m,z_m\n1,0,0,0\n";
   std::ofstream(dir + "/odom.csv") << "t_s,dt_s,v_mps,omega_radps\n"
                                       "1.0,0.1,0.5,0\n"
-                                      "1.1,0.1,nan,0\n"       // not finite
-                                      "1.2,0.1,0.5\n"         // a column short
-                                      "1.05,0.1,0.5,0\n"      // ends before the previous one
-                                      "1.3,-0.1,0.5,0\n"      // negative interval
+                                      "1.1,0.1,nan,0\n"   // not finite
+                                      "1.2,0.1,0.5\n"     // a column short
+                                      "1.05,0.1,0.5,0\n"  // ends before the previous one
+                                      "1.3,-0.1,0.5,0\n"  // negative interval
                                       "1.4,0.1,0.5,0\n";
-  std::ofstream(dir + "/ranges.csv") << "t_s,beacon_id,range_m\n1.0,1,3.0\n1.1,abc,3.0\n1.2,1.5,3.0\n0.9,1,3.1\n";
+  std::ofstream(dir + "/ranges.csv")
+      << "t_s,beacon_id,range_m\n1.0,1,3.0\n1.1,abc,3.0\n1.2,1.5,3.0\n0.9,1,3.1\n";
   std::ofstream(dir + "/gt.csv") << "t_s,x_m,y_m\n1.0,0,0\n1.0,0,0\n";
   ReplaySource replay(dir);
   const auto& c = replay.load_counts();
@@ -109,14 +110,15 @@ TEST(Replay, MissingFilesAndHeadersAreErrorsNamingTheFile) {
   try {
     ReplaySource replay(dir);
     FAIL();
-  } catch (const ReplayError& e) {
-    EXPECT_NE(std::string(e.what()).find("beacons.csv:1: header lacks column 'z_m'"), std::string::npos) << e.what();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("beacons.csv:1: header lacks column 'z_m'"), std::string::npos)
+        << e.what();
   }
   std::ofstream(dir + "/beacons.csv") << "beacon_id,x_m,y_m,z_m\n1,0,0,0\n";
   try {
     ReplaySource replay(dir);
     FAIL();
-  } catch (const ReplayError& e) {
+  } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("odom.csv"), std::string::npos) << e.what();
   }
 }
@@ -124,18 +126,22 @@ TEST(Replay, MissingFilesAndHeadersAreErrorsNamingTheFile) {
 TEST(Replay, SharedRecordingsLoad) {
   const std::vector<std::pair<std::string, std::size_t>> recordings = {
       {"tuc_labyrinth_uwb/replay/full_933s", 7273}, {"cmu_plaza_gpslam/replay/plaza1", 3529}};
+  int loaded = 0;
   for (const auto& [dir, ranges] : recordings) {
     const std::string path = kShared + "/" + dir;
     if (!std::filesystem::exists(path)) {
-      std::printf("skipped %s: the shared datasets are not beside the repository (%s)\n", dir.c_str(), path.c_str());
+      std::printf("skipped %s: the shared datasets are not beside the repository (%s)\n", dir.c_str(),
+                  path.c_str());
       continue;
     }
+    ++loaded;
     ReplaySource replay(path);
     EXPECT_EQ(replay.load_counts().rejected_total(), 0u) << dir;
     std::size_t tofs = 0;
     for (const auto& e : everything(replay)) tofs += e.kind == SourceEvent::Kind::kTof;
     EXPECT_EQ(tofs, ranges) << dir;
   }
+  if (loaded == 0) GTEST_SKIP() << "no shared dataset beside the repository";
 }
 
 }  // namespace

@@ -1,10 +1,11 @@
 // Scenario files: every shipped file loads; the built-in default is default.yaml; a bad file
 // gets an error naming the key and its line.
+#include "sim/scenario_yaml.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
 
-#include "sim/scenario_yaml.hpp"
 #include "sim/sim_source.hpp"
 
 namespace beaconloc::sim {
@@ -72,9 +73,11 @@ TEST(ScenarioYaml, MinimalFileUsesTheDocumentedDefaults) {
 
 TEST(ScenarioYaml, ErrorsNameTheKeyAndLine) {
   EXPECT_EQ(error_of(std::string(kMinimal) + "colour: red\n"), "test.yaml:9: 'colour' is not a known key");
-  EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {range_sigma_m: -1}\n").find("'beacon_system.range_sigma_m' must be in"),
+  EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {range_sigma_m: -1}\n")
+                .find("'beacon_system.range_sigma_m' must be in"),
             std::string::npos);
-  EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {identified: maybe}\n").find("'beacon_system.identified' has the wrong type"),
+  EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {identified: maybe}\n")
+                .find("'beacon_system.identified' has the wrong type"),
             std::string::npos);
   EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {firing_order: [7]}\n").find("names beacon 7"),
             std::string::npos);

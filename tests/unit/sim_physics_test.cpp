@@ -134,7 +134,7 @@ TEST(SimPhysics, LaserRaysAreCastOnTheMap) {
   Scenario s = still_world();
   s.trajectory = Trajectory({1.0, 1.0, M_PI / 2}, {{100.0, 0.0, 0.0}}, false);
   OccupancyGrid grid({0.0, 0.0}, 0.1, 40, 30);  // 4 m x 3 m room
-  grid.fill_border();                             // inner faces at x 0.1, 3.9 and y 0.1, 2.9
+  grid.fill_border();                           // inner faces at x 0.1, 3.9 and y 0.1, 2.9
   s.map = grid;
   LaserModel laser;
   laser.beams = 3;

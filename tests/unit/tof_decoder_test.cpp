@@ -84,11 +84,16 @@ TEST(TofDecoder, CountsEveryRejectionByReason) {
   ASSERT_TRUE(d.decode("r1", dup).range);  // 100 ms out of order: still useful, accepted
   expect_rejected(dup, TofRejection::kDuplicate);
 
+  // Before the map: held, and refused only when it ages out (or overflows the backlog).
   TofDecoder no_map;
-  const auto out = no_map.decode("r1", good(1));
-  ASSERT_TRUE(out.rejection);
-  EXPECT_EQ(*out.rejection, TofRejection::kNoBeaconMap);
+  EXPECT_TRUE(no_map.decode("r1", good(1, 1'000'000'000)).deferred);
+  EXPECT_TRUE(no_map.decode("r1", good(2, 1'700'000'000)).deferred);  // the first is now 700 ms old
   EXPECT_EQ(no_map.counts().rejected("no_beacon_map"), 1u);
+  const auto held = no_map.set_beacon_map(BeaconMap({{1, {0.0, 0.0, 2.011}, 0}}));
+  ASSERT_EQ(held.size(), 1u);  // the second one, decoded once the map came
+  EXPECT_EQ(held[0].source_sequence_number, 2u);
+  EXPECT_EQ(held[0].robot_id, "r1");
+  EXPECT_EQ(no_map.counts().accepted(), 1u);
 
   const auto& c = d.counts();
   EXPECT_EQ(c.rejected("non_finite_tof"), 2u);

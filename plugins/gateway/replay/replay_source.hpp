@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "beaconloc/core/csv_reader.hpp"
 #include "beaconloc/core/rejection_counter.hpp"
 #include "source.hpp"
 
@@ -59,7 +60,9 @@ class ReplaySource final : public Source {
   void load_odometry(const std::string& path);
   void load_ranges(const std::string& path);
   void load_truth(const std::string& path);
-  void refuse(const std::string& file, std::size_t line, const std::string& reason, const std::string& detail);
+  static CsvReader open(const std::string& path, const std::vector<std::string>& columns);
+  void refuse(const std::string& file, std::size_t line, const std::string& reason,
+              const std::string& detail);
 
   std::string directory_;
   ReplayOptions options_;

@@ -38,17 +38,17 @@ struct Scenario {
 
   std::vector<Beacon> beacons;
   // Beacon system.
-  std::vector<std::uint32_t> firing_order;  // beacon ids, one per slot, cycled
+  std::vector<std::uint32_t> firing_order;           // beacon ids, one per slot, cycled
   StampNs slot_period_ns = 200 * kNsPerMillisecond;  // 5 Hz firing slots
   StampNs first_slot_ns = 50 * kNsPerMillisecond;
-  bool identified = true;                     // false: anonymous pulses
+  bool identified = true;                         // false: anonymous pulses
   std::optional<std::uint32_t> marked_beacon_id;  // recognisable even when anonymous
-  double range_sigma_m = 0.01;                // seed 000: sigma_dd
-  double tof_sigma_s = 0.0;                   // seed 002: arrival-time noise
-  double min_range_m = 0.0;                   // a receiver hears slant ranges in [min, max]
+  double range_sigma_m = 0.01;                    // seed 000: sigma_dd
+  double tof_sigma_s = 0.0;                       // seed 002: arrival-time noise
+  double min_range_m = 0.0;                       // a receiver hears slant ranges in [min, max]
   double max_range_m = 5.0;
-  double beam_half_angle_rad = M_PI / 2;      // cone around the beacon's downward axis
-  double temperature_c = 22.0;                // true air temperature
+  double beam_half_angle_rad = M_PI / 2;         // cone around the beacon's downward axis
+  double temperature_c = 22.0;                   // true air temperature
   std::optional<double> reported_temperature_c;  // what beacons report; default: the truth
   EchoModel echo;
 
@@ -56,10 +56,10 @@ struct Scenario {
   ReceiverArray receivers;
   double wheel_base_m = 0.33;
   StampNs odometry_period_ns = 10 * kNsPerMillisecond;  // 100 Hz
-  double odometry_k_v_m = 4e-4;               // seed 000: sigma_v^2 = k_v |v| / dT per wheel
-  double wheel_radius_error_right = 0.0;      // measured wheel speed = true * (1 + error)
+  double odometry_k_v_m = 4e-4;                         // seed 000: sigma_v^2 = k_v |v| / dT per wheel
+  double wheel_radius_error_right = 0.0;                // measured wheel speed = true * (1 + error)
   double wheel_radius_error_left = 0.0;
-  double wheel_base_error = 0.0;              // reported B_w = true * (1 + error)
+  double wheel_base_error = 0.0;  // reported B_w = true * (1 + error)
 
   Trajectory trajectory;
   std::optional<OccupancyGrid> map;

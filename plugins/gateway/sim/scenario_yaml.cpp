@@ -100,10 +100,12 @@ void read_beacons(const Section& root, Scenario& sc) {
   std::set<std::uint32_t> ids;
   const YAML::Node list = root.node("beacons");
   for (std::size_t i = 0; i < list.size(); ++i) {
-    const Section b(list[i], "beacons[" + std::to_string(i) + "]", root.origin(), {"id", "position_m", "group"});
+    const Section b(list[i], "beacons[" + std::to_string(i) + "]", root.origin(),
+                    {"id", "position_m", "group"});
     Beacon beacon;
     beacon.id = b.required<std::uint32_t>("id");
-    if (beacon.id == kBeaconUnidentified) b.fail(b.join("id"), "is reserved for unidentified pulses", list[i]);
+    if (beacon.id == kBeaconUnidentified)
+      b.fail(b.join("id"), "is reserved for unidentified pulses", list[i]);
     if (!ids.insert(beacon.id).second) b.fail(b.join("id"), "repeats an earlier beacon id", list[i]);
     if (!b.has("position_m")) b.fail(b.join("position_m"), "is required", list[i]);
     beacon.position_map_m = vec3(b, b.node("position_m"), b.join("position_m"));
@@ -115,10 +117,10 @@ void read_beacons(const Section& root, Scenario& sc) {
 void read_beacon_system(const Section& root, Scenario& sc) {
   for (const auto& b : sc.beacons) sc.firing_order.push_back(b.id);
   if (!root.has("beacon_system")) return;
-  const Section s = root.child("beacon_system", {"slot_period_s", "first_slot_s", "firing_order", "identified",
-                                                  "marked_beacon_id", "range_sigma_m", "tof_sigma_s",
-                                                  "min_range_m", "max_range_m", "beam_half_angle_deg",
-                                                  "temperature_c", "reported_temperature_c", "echo"});
+  const Section s = root.child(
+      "beacon_system", {"slot_period_s", "first_slot_s", "firing_order", "identified", "marked_beacon_id",
+                        "range_sigma_m", "tof_sigma_s", "min_range_m", "max_range_m", "beam_half_angle_deg",
+                        "temperature_c", "reported_temperature_c", "echo"});
   sc.slot_period_ns = duration_ns(s, "slot_period_s", 0.2);
   sc.first_slot_ns = s_to_ns(s.number("first_slot_s", 0.05, 0.0, 3600.0));
   if (s.has("firing_order")) {
@@ -127,7 +129,9 @@ void read_beacon_system(const Section& root, Scenario& sc) {
     for (auto id : sc.firing_order) {
       bool known = false;
       for (const auto& b : sc.beacons) known = known || b.id == id;
-      if (!known) s.fail(s.join("firing_order"), "names beacon " + std::to_string(id) + ", which is not in beacons", s.node("firing_order"));
+      if (!known)
+        s.fail(s.join("firing_order"), "names beacon " + std::to_string(id) + ", which is not in beacons",
+               s.node("firing_order"));
     }
   }
   sc.identified = s.get<bool>("identified", true);
@@ -136,10 +140,12 @@ void read_beacon_system(const Section& root, Scenario& sc) {
   sc.tof_sigma_s = s.number("tof_sigma_s", 0.0, 0.0, 1.0);
   sc.min_range_m = s.number("min_range_m", 0.0, 0.0, 1e4);
   sc.max_range_m = s.number("max_range_m", 5.0, 0.0, 1e4);
-  if (sc.max_range_m <= sc.min_range_m) s.fail(s.join("max_range_m"), "must exceed min_range_m", s.node("max_range_m"));
+  if (sc.max_range_m <= sc.min_range_m)
+    s.fail(s.join("max_range_m"), "must exceed min_range_m", s.node("max_range_m"));
   sc.beam_half_angle_rad = s.number("beam_half_angle_deg", 90.0, 0.1, 180.0) * M_PI / 180.0;
   sc.temperature_c = s.number("temperature_c", 22.0, -40.0, 60.0);
-  if (s.has("reported_temperature_c")) sc.reported_temperature_c = s.number("reported_temperature_c", 0.0, -40.0, 60.0);
+  if (s.has("reported_temperature_c"))
+    sc.reported_temperature_c = s.number("reported_temperature_c", 0.0, -40.0, 60.0);
   if (s.has("echo")) {
     const Section e = s.child("echo", {"probability", "min_extra_path_m", "max_extra_path_m"});
     sc.echo.probability = e.number("probability", 0.0, 0.0, 1.0);
@@ -166,7 +172,8 @@ void read_robot(const Section& root, Scenario& sc) {
     if (!list.IsSequence() || list.size() == 0) rx.fail(rx.join("positions_m"), "must list receivers", list);
     sc.receivers.receivers_base_m.clear();
     for (std::size_t i = 0; i < list.size(); ++i) {
-      sc.receivers.receivers_base_m.push_back(vec2(rx, list[i], rx.join("positions_m") + "[" + std::to_string(i) + "]"));
+      sc.receivers.receivers_base_m.push_back(
+          vec2(rx, list[i], rx.join("positions_m") + "[" + std::to_string(i) + "]"));
     }
   }
   sc.receivers.receiver_height_m = rx.number("height_m", 0.0, -10.0, 10.0);
@@ -183,8 +190,8 @@ void read_robot(const Section& root, Scenario& sc) {
 
 void read_trajectory(const Section& root, Scenario& sc) {
   if (!root.has("trajectory")) root.fail("trajectory", "is required", root.node("trajectory"));
-  const Section t = root.child("trajectory", {"start_pose", "loop", "segments", "waypoints_m", "speed_mps",
-                                              "turn_rate_radps"});
+  const Section t = root.child(
+      "trajectory", {"start_pose", "loop", "segments", "waypoints_m", "speed_mps", "turn_rate_radps"});
   if (t.has("segments") == t.has("waypoints_m")) {
     t.fail(t.join("segments"), "or 'waypoints_m' is required, not both", root.node("trajectory"));
   }
@@ -199,19 +206,23 @@ void read_trajectory(const Section& root, Scenario& sc) {
       segments.push_back({s.number("duration_s", 0.0, 1e-6, 1e5), s.number("linear_mps", 0.0, -10.0, 10.0),
                           s.number("angular_radps", 0.0, -10.0, 10.0)});
     }
-    if (!t.has("start_pose")) t.fail(t.join("start_pose"), "is required with segments", root.node("trajectory"));
-    sc.trajectory = Trajectory(vec3(t, t.node("start_pose"), t.join("start_pose")), segments, t.get<bool>("loop", false));
+    if (!t.has("start_pose"))
+      t.fail(t.join("start_pose"), "is required with segments", root.node("trajectory"));
+    sc.trajectory =
+        Trajectory(vec3(t, t.node("start_pose"), t.join("start_pose")), segments, t.get<bool>("loop", false));
     return;
   }
   if (t.has("start_pose") || t.has("loop")) {
-    t.fail(t.join("waypoints_m"), "paths start at their first waypoint and do not loop", root.node("trajectory"));
+    t.fail(t.join("waypoints_m"), "paths start at their first waypoint and do not loop",
+           root.node("trajectory"));
   }
   const YAML::Node list = t.node("waypoints_m");
   std::vector<Eigen::Vector2d> waypoints;
   for (std::size_t i = 0; list.IsSequence() && i < list.size(); ++i) {
     waypoints.push_back(vec2(t, list[i], t.join("waypoints_m") + "[" + std::to_string(i) + "]"));
   }
-  if (!t.has("speed_mps")) t.fail(t.join("speed_mps"), "is required with waypoints_m", root.node("trajectory"));
+  if (!t.has("speed_mps"))
+    t.fail(t.join("speed_mps"), "is required with waypoints_m", root.node("trajectory"));
   try {
     sc.trajectory = Trajectory::from_waypoints(waypoints, t.number("speed_mps", 0.0, 1e-3, 10.0),
                                                t.number("turn_rate_radps", 0.5, 1e-3, 10.0));
@@ -226,16 +237,20 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
     const double res = m.number("resolution_m", 0.1, 0.005, 10.0);
     if (!m.has("size_m")) m.fail(m.join("size_m"), "is required", root.node("map"));
     const Eigen::Vector2d size = vec2(m, m.node("size_m"), m.join("size_m"));
-    if (size.minCoeff() <= 0.0 || size.maxCoeff() / res > 20000) m.fail(m.join("size_m"), "must be positive and at most 20000 cells a side", m.node("size_m"));
-    const Eigen::Vector2d origin = m.has("origin_m") ? vec2(m, m.node("origin_m"), m.join("origin_m")) : Eigen::Vector2d::Zero();
+    if (size.minCoeff() <= 0.0 || size.maxCoeff() / res > 20000)
+      m.fail(m.join("size_m"), "must be positive and at most 20000 cells a side", m.node("size_m"));
+    const Eigen::Vector2d origin =
+        m.has("origin_m") ? vec2(m, m.node("origin_m"), m.join("origin_m")) : Eigen::Vector2d::Zero();
     OccupancyGrid grid(origin, res, static_cast<int>(std::ceil(size.x() / res - 1e-9)),
                        static_cast<int>(std::ceil(size.y() / res - 1e-9)));
     if (m.get<bool>("border", true)) grid.fill_border();
     const YAML::Node obstacles = m.node("obstacles");
     for (std::size_t i = 0; obstacles && obstacles.IsSequence() && i < obstacles.size(); ++i) {
-      const Section o(obstacles[i], m.join("obstacles") + "[" + std::to_string(i) + "]", root.origin(), {"min_m", "max_m"});
+      const Section o(obstacles[i], m.join("obstacles") + "[" + std::to_string(i) + "]", root.origin(),
+                      {"min_m", "max_m"});
       if (!o.has("min_m") || !o.has("max_m")) o.fail(o.join("min_m"), "and max_m are required", obstacles[i]);
-      const Eigen::Vector2d lo = vec2(o, o.node("min_m"), o.join("min_m")), hi = vec2(o, o.node("max_m"), o.join("max_m"));
+      const Eigen::Vector2d lo = vec2(o, o.node("min_m"), o.join("min_m")),
+                            hi = vec2(o, o.node("max_m"), o.join("max_m"));
       if ((hi.array() <= lo.array()).any()) o.fail(o.join("max_m"), "must exceed min_m", obstacles[i]);
       grid.fill_rectangle(lo, hi);
     }
@@ -243,7 +258,8 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
   }
   if (root.has("laser")) {
     if (!sc.map) root.fail("laser", "needs a map to cast its rays on", root.node("laser"));
-    const Section l = root.child("laser", {"beams", "fov_deg", "period_s", "range_sigma_m", "max_range_m", "mount_m"});
+    const Section l =
+        root.child("laser", {"beams", "fov_deg", "period_s", "range_sigma_m", "max_range_m", "mount_m"});
     LaserModel laser;
     laser.beams = static_cast<int>(l.number("beams", 19, 1, 4096));
     laser.fov_rad = l.number("fov_deg", 180.0, 0.0, 360.0) * M_PI / 180.0;
@@ -264,8 +280,9 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
   } catch (const YAML::Exception& e) {
     throw ScenarioError(origin + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
   }
-  const Section root(doc, "", origin, {"name", "description", "seed", "duration_s", "beacons", "beacon_system",
-                                       "robot", "trajectory", "map", "laser"});
+  const Section root(doc, "", origin,
+                     {"name", "description", "seed", "duration_s", "beacons", "beacon_system", "robot",
+                      "trajectory", "map", "laser"});
   Scenario sc;
   sc.name = root.required<std::string>("name");
   sc.description = root.get<std::string>("description", "");

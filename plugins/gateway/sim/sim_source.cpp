@@ -8,8 +8,7 @@
 namespace beaconloc::sim {
 
 double pulse_arrival_s(const Trajectory& trajectory, const Eigen::Vector2d& receiver_base_m,
-                       double receiver_z_m, const Eigen::Vector3d& beacon_map_m, double fire_s,
-                       double c) {
+                       double receiver_z_m, const Eigen::Vector3d& beacon_map_m, double fire_s, double c) {
   double arrival_s = fire_s;
   for (int i = 0; i < 6; ++i) {
     const Eigen::Vector2d rx = transform_point(trajectory.pose_at(arrival_s), receiver_base_m);
@@ -63,10 +62,12 @@ void SimSource::fire(StampNs fire_ns) {
     e.tof.beacon_id = announces_id ? beacon_id : kBeaconUnidentified;
     e.tof.receiver_id = rx;
     e.tof.fire_stamp_ns = fire_ns;
-    e.tof.tof_s = arrival_s - fire_s + scenario_.range_sigma_m / c * normal() + scenario_.tof_sigma_s * normal();
+    e.tof.tof_s =
+        arrival_s - fire_s + scenario_.range_sigma_m / c * normal() + scenario_.tof_sigma_s * normal();
     if (scenario_.echo.probability > 0.0 && uniform() < scenario_.echo.probability) {
       const auto& echo = scenario_.echo;
-      e.tof.tof_s += (echo.min_extra_path_m + uniform() * (echo.max_extra_path_m - echo.min_extra_path_m)) / c;
+      e.tof.tof_s +=
+          (echo.min_extra_path_m + uniform() * (echo.max_extra_path_m - echo.min_extra_path_m)) / c;
       e.tof_is_echo = true;
     }
     e.tof.beacon_temperature_c = scenario_.reported_temperature_c.value_or(scenario_.temperature_c);

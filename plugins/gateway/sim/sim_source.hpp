@@ -62,6 +62,7 @@ double pulse_arrival_s(const Trajectory& trajectory, const Eigen::Vector2d& rece
 
 // Whether a receiver at receiver_map_m hears a beacon: slant range within [min, max] and inside
 // the cone of half-angle beam_half_angle_rad around the beacon's downward axis.
-bool hears(const Scenario& scenario, const Eigen::Vector3d& beacon_map_m, const Eigen::Vector3d& receiver_map_m);
+bool hears(const Scenario& scenario, const Eigen::Vector3d& beacon_map_m,
+           const Eigen::Vector3d& receiver_map_m);
 
 }  // namespace beaconloc::sim

@@ -29,8 +29,9 @@ Trajectory Trajectory::from_waypoints(const std::vector<Eigen::Vector2d>& waypoi
   const Pose2 start(waypoints[0].x(), waypoints[0].y(), heading);
   for (std::size_t i = 0; i + 1 < waypoints.size(); ++i) {
     const Eigen::Vector2d leg = waypoints[i + 1] - waypoints[i];
-    if (leg.norm() < 1e-9) throw std::invalid_argument("waypoints " + std::to_string(i) + " and " +
-                                                       std::to_string(i + 1) + " coincide");
+    if (leg.norm() < 1e-9)
+      throw std::invalid_argument("waypoints " + std::to_string(i) + " and " + std::to_string(i + 1) +
+                                  " coincide");
     const double turn = wrap_angle_rad(std::atan2(leg.y(), leg.x()) - heading);
     if (std::abs(turn) > 1e-12) {
       segments.push_back({std::abs(turn) / turn_rate, 0.0, turn > 0 ? turn_rate : -turn_rate});

@@ -78,8 +78,8 @@ std::optional<double> OccupancyGrid::cast_ray(const Eigen::Vector2d& from_m, dou
     }
     if (t > max_range_m) return std::nullopt;
     if (occupied(ix, iy)) return t;
-    const bool leaving = (ix < 0 && step_x < 0) || (ix >= width_ && step_x > 0) ||
-                         (iy < 0 && step_y < 0) || (iy >= height_ && step_y > 0);
+    const bool leaving = (ix < 0 && step_x < 0) || (ix >= width_ && step_x > 0) || (iy < 0 && step_y < 0) ||
+                         (iy >= height_ && step_y > 0);
     if (leaving) return std::nullopt;
   }
 }

@@ -123,7 +123,8 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r) {
 void RangeEkf::try_initialize() {
   // The multi-start solve costs ~1 ms: not more often than init_retry_interval_s of data time.
   const StampNs now_ns = window_.back().range.stamp_ns;
-  if (last_init_attempt_ns_ && now_ns - *last_init_attempt_ns_ < s_to_ns(params_.init_retry_interval_s)) return;
+  if (last_init_attempt_ns_ && now_ns - *last_init_attempt_ns_ < s_to_ns(params_.init_retry_interval_s))
+    return;
   std::set<std::uint32_t> beacons;
   for (const auto& b : window_) beacons.insert(b.range.beacon_id);
   if (static_cast<int>(beacons.size()) < params_.init_min_beacons) return;

@@ -20,9 +20,9 @@ struct RangeEkfParameters {
   double init_max_yaw_sigma_rad = 0.35;
   double max_odometry_gap_s = 0.2;  // a longer gap is not integrated (reason odometry_gap)
   double wheel_velocity_variance_floor_m2ps2 = 1e-6;
-  int reinitialize_after_gated = 15;  // 5 slots x 3 receivers refused in a row: lost
-  double max_range_age_s = 0.6;       // ranges older than the newest odometry by more: stale
-  double init_retry_interval_s = 0.5; // data time between two attempts at a global fix
+  int reinitialize_after_gated = 15;   // 5 slots x 3 receivers refused in a row: lost
+  double max_range_age_s = 0.6;        // ranges older than the newest odometry by more: stale
+  double init_retry_interval_s = 0.5;  // data time between two attempts at a global fix
 
   static RangeEkfParameters from(const EstimatorConfig& config);
 };
