@@ -121,6 +121,32 @@ TEST(SimPhysics, SystematicWheelErrorsBiasTheOdometry) {
   EXPECT_EQ(checked, 100);
 }
 
+TEST(SimPhysics, VelocityNoiseFollowsSeed001Alphas) {
+  // Straight at 0.5 m/s with alpha = [0.02, 0, 0.01, 0]: sigma_v^2 = 0.005, sigma_w^2 = 0.0025.
+  Scenario s = still_world();
+  s.wheel_base_m = 0.4;
+  s.trajectory = Trajectory({0.0, 0.0, 0.0}, {{1000.0, 0.5, 0.0}}, false);
+  s.odometry_alpha = std::array<double, 4>{0.02, 0.0, 0.01, 0.0};
+  SimSource source(s, 9);
+  std::vector<SourceEvent> events;
+  source.advance(s_to_ns(200.0), events);
+  double sum_v = 0, sum_vv = 0, sum_ww = 0;
+  int n = 0;
+  for (const auto& e : events) {
+    if (e.kind != SourceEvent::Kind::kOdometry) continue;
+    const auto& o = e.odometry;
+    const double v = (o.wheel_velocity_right_mps + o.wheel_velocity_left_mps) / 2.0 - 0.5;
+    const double w = (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / o.wheel_base_m;
+    sum_v += v;
+    sum_vv += v * v;
+    sum_ww += w * w;
+    ++n;
+  }
+  EXPECT_NEAR(sum_v / n, 0.0, 5.0 * std::sqrt(0.005 / n));
+  EXPECT_NEAR(sum_vv / n, 0.005, 0.05 * 0.005);
+  EXPECT_NEAR(sum_ww / n, 0.0025, 0.05 * 0.0025);
+}
+
 TEST(SimPhysics, AnonymousPulsesCarryNoIdButTheMarkedOne) {
   Scenario s = still_world();
   s.identified = false;

@@ -2,6 +2,7 @@
 // A simulated world: ceiling beacons, the robot's receivers and wheels, a path, the beacon
 // system's timing and physics, and optionally a map and a laser. Loaded from the YAML files of
 // examples/scenarios/ (schema in its README) or built in (default_scenario).
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -60,6 +61,9 @@ struct Scenario {
   double wheel_radius_error_right = 0.0;                // measured wheel speed = true * (1 + error)
   double wheel_radius_error_left = 0.0;
   double wheel_base_error = 0.0;  // reported B_w = true * (1 + error)
+  // Seed 001 eq. 6 instead of k_v: per odometry sample, noise on (v, w) with variances
+  // alpha_1 v^2 + alpha_2 w^2 and alpha_3 v^2 + alpha_4 w^2.
+  std::optional<std::array<double, 4>> odometry_alpha;
 
   Trajectory trajectory;
   std::optional<OccupancyGrid> map;

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -178,13 +179,23 @@ void read_robot(const Section& root, Scenario& sc) {
   }
   sc.receivers.receiver_height_m = rx.number("height_m", 0.0, -10.0, 10.0);
   if (r.has("odometry")) {
-    const Section o = r.child("odometry", {"period_s", "k_v_m", "wheel_radius_error_right",
+    const Section o = r.child("odometry", {"period_s", "k_v_m", "alpha", "wheel_radius_error_right",
                                            "wheel_radius_error_left", "wheel_base_error"});
     sc.odometry_period_ns = duration_ns(o, "period_s", 0.01);
     sc.odometry_k_v_m = o.number("k_v_m", 4e-4, 0.0, 1.0);
     sc.wheel_radius_error_right = o.number("wheel_radius_error_right", 0.0, -0.5, 0.5);
     sc.wheel_radius_error_left = o.number("wheel_radius_error_left", 0.0, -0.5, 0.5);
     sc.wheel_base_error = o.number("wheel_base_error", 0.0, -0.5, 0.5);
+    if (o.has("alpha")) {
+      if (o.has("k_v_m")) o.fail(o.join("alpha"), "and k_v_m exclude each other", o.node("alpha"));
+      const auto a = o.as<std::vector<double>>(o.node("alpha"), o.join("alpha"));
+      if (a.size() != 4 || *std::min_element(a.begin(), a.end()) < 0.0 ||
+          *std::max_element(a.begin(), a.end()) > 10.0) {
+        o.fail(o.join("alpha"), "must be four numbers in [0, 10]", o.node("alpha"));
+      }
+      sc.odometry_alpha = std::array<double, 4>{a[0], a[1], a[2], a[3]};
+      sc.odometry_k_v_m = 0.0;
+    }
   }
 }
 

@@ -83,24 +83,42 @@ SourceEvent SimSource::odometry_at(StampNs stamp_ns) {
   double v = 0.0, w = 0.0;
   scenario_.trajectory.mean_velocity(t1 - dt_s, t1, v, w);
   const double half_track = scenario_.wheel_base_m / 2.0;
-  // Systematic errors (wheel radii) scale what the encoders report; then the random error of
-  // seed 000, sigma_v^2 = k_v |v| / dT for each wheel.
-  const double right = (v + w * half_track) * (1.0 + scenario_.wheel_radius_error_right);
-  const double left = (v - w * half_track) * (1.0 + scenario_.wheel_radius_error_left);
-  auto noisy = [&](double wheel_mps) {
-    return wheel_mps + std::sqrt(scenario_.odometry_k_v_m * std::abs(wheel_mps) / dt_s) * normal();
-  };
+  const double reported_base = scenario_.wheel_base_m * (1.0 + scenario_.wheel_base_error);
   SourceEvent e;
   e.kind = SourceEvent::Kind::kOdometry;
   e.stamp_ns = stamp_ns;
   e.odometry.stamp_ns = stamp_ns;
-  e.odometry.wheel_velocity_right_mps = noisy(right);
-  e.odometry.wheel_velocity_left_mps = noisy(left);
-  e.odometry.wheel_base_m = scenario_.wheel_base_m * (1.0 + scenario_.wheel_base_error);
-  // The robot reports the noise model evaluated at what it measured (it cannot know the truth).
-  e.odometry.wheel_velocity_covariance.diagonal()
-      << scenario_.odometry_k_v_m * std::abs(e.odometry.wheel_velocity_right_mps) / dt_s,
-      scenario_.odometry_k_v_m * std::abs(e.odometry.wheel_velocity_left_mps) / dt_s;
+  e.odometry.wheel_base_m = reported_base;
+  // Systematic errors (wheel radii) scale what the encoders report.
+  double right = (v + w * half_track) * (1.0 + scenario_.wheel_radius_error_right);
+  double left = (v - w * half_track) * (1.0 + scenario_.wheel_radius_error_left);
+  if (scenario_.odometry_alpha) {
+    // Seed 001 eq. 6: noise on the velocities the robot reports, (v, w) from its wheels.
+    const auto& a = *scenario_.odometry_alpha;
+    const auto variances = [&a](double lin, double ang) {
+      return Eigen::Vector2d(a[0] * lin * lin + a[1] * ang * ang, a[2] * lin * lin + a[3] * ang * ang);
+    };
+    double v_meas = (right + left) / 2.0, w_meas = (right - left) / reported_base;
+    const Eigen::Vector2d true_var = variances(v_meas, w_meas);
+    v_meas += std::sqrt(true_var.x()) * normal();
+    w_meas += std::sqrt(true_var.y()) * normal();
+    right = v_meas + w_meas * reported_base / 2.0;
+    left = v_meas - w_meas * reported_base / 2.0;
+    // Reported: the model at what was measured, carried to the wheels by
+    // [v_R, v_L] = [[1, B/2], [1, -B/2]] [v, w].
+    Eigen::Matrix2d to_wheels;
+    to_wheels << 1.0, reported_base / 2.0, 1.0, -reported_base / 2.0;
+    e.odometry.wheel_velocity_covariance =
+        to_wheels * variances(v_meas, w_meas).asDiagonal() * to_wheels.transpose();
+  } else {
+    // Seed 000: sigma_v^2 = k_v |v| / dT for each wheel, reported at what was measured.
+    right += std::sqrt(scenario_.odometry_k_v_m * std::abs(right) / dt_s) * normal();
+    left += std::sqrt(scenario_.odometry_k_v_m * std::abs(left) / dt_s) * normal();
+    e.odometry.wheel_velocity_covariance.diagonal() << scenario_.odometry_k_v_m * std::abs(right) / dt_s,
+        scenario_.odometry_k_v_m * std::abs(left) / dt_s;
+  }
+  e.odometry.wheel_velocity_right_mps = right;
+  e.odometry.wheel_velocity_left_mps = left;
   e.has_truth = true;
   e.truth_map_base = scenario_.trajectory.pose_at(t1);
   return e;

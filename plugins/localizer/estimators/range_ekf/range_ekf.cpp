@@ -1,5 +1,6 @@
 #include "range_ekf.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <set>
 
@@ -15,6 +16,7 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
   p.nis_gate = c.parameter("nis_gate", p.nis_gate);
   p.init_window_s = c.parameter("init_window_s", p.init_window_s);
   p.init_min_beacons = static_cast<int>(c.parameter("init_min_beacons", p.init_min_beacons));
+  p.init_min_beacon_spread_m = c.parameter("init_min_beacon_spread_m", p.init_min_beacon_spread_m);
   p.max_odometry_gap_s = c.parameter("max_odometry_gap_s", p.max_odometry_gap_s);
   p.reinitialize_after_gated =
       static_cast<int>(c.parameter("reinitialize_after_gated", p.reinitialize_after_gated));
@@ -128,6 +130,19 @@ void RangeEkf::try_initialize() {
   std::set<std::uint32_t> beacons;
   for (const auto& b : window_) beacons.insert(b.range.beacon_id);
   if (static_cast<int>(beacons.size()) < params_.init_min_beacons) return;
+  // Spread of the beacons across their principal axis (smallest eigenvalue of their scatter).
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (auto id : beacons) mean += map_.find(id)->position_map_m.head<2>();
+  mean /= static_cast<double>(beacons.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (auto id : beacons) {
+    const Eigen::Vector2d d = map_.find(id)->position_map_m.head<2>() - mean;
+    scatter += d * d.transpose() / static_cast<double>(beacons.size());
+  }
+  if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter).eigenvalues().minCoeff() <
+      params_.init_min_beacon_spread_m * params_.init_min_beacon_spread_m) {
+    return;
+  }
   last_init_attempt_ns_ = now_ns;
 
   std::vector<RangeObservation> observations;

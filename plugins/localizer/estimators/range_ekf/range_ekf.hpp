@@ -16,6 +16,9 @@ struct RangeEkfParameters {
   double nis_gate = 10.83;     // chi-square, 1 dof, 99.9 %
   double init_window_s = 3.0;  // ranges kept for a global fix
   int init_min_beacons = 3;
+  // Beacons all on one line leave the mirror image of the pose as good a fit: a global fix
+  // waits until the beacons heard spread this far across their principal axis (RMS).
+  double init_min_beacon_spread_m = 0.2;
   double init_max_position_sigma_m = 0.3;
   double init_max_yaw_sigma_rad = 0.35;
   double max_odometry_gap_s = 0.2;  // a longer gap is not integrated (reason odometry_gap)
