@@ -1,5 +1,7 @@
 #include "beaconloc/core/estimator.hpp"
 
+#include <cmath>
+
 #include "beaconloc/core/estimator_registry.hpp"
 
 namespace beaconloc {
@@ -16,6 +18,17 @@ const char* to_string(PoseStatus s) {
       return "lost";
   }
   return "unknown";
+}
+
+InputResult check_range(const RangeMeasurement& r, const BeaconMap& map, std::size_t receiver_count) {
+  if (!std::isfinite(r.range_m) || !std::isfinite(r.variance_m2))
+    return InputResult::rejected("non_finite_range");
+  if (!(r.range_m > 0.0) || !(r.variance_m2 > 0.0)) return InputResult::rejected("invalid_range");
+  if (r.beacon_id == kBeaconUnidentified) return InputResult::rejected("unassociated_range");
+  if (map.empty()) return InputResult::rejected("no_beacon_map");
+  if (!map.find(r.beacon_id)) return InputResult::rejected("unknown_beacon");
+  if (r.receiver_id >= receiver_count) return InputResult::rejected("unknown_receiver");
+  return InputResult::ok();
 }
 
 EstimatorRegistry& EstimatorRegistry::instance() {

@@ -28,31 +28,14 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
 }
 
 RangeEkf::RangeEkf(const EstimatorConfig& config)
-    : receivers_(config.receivers), params_(RangeEkfParameters::from(config)) {}
+    : receivers_(config.receivers),
+      params_(RangeEkfParameters::from(config)),
+      timeline_(params_.max_odometry_gap_s) {}
 
 InputResult RangeEkf::predict(const OdometrySample& o) {
-  const bool finite = std::isfinite(o.wheel_velocity_right_mps) && std::isfinite(o.wheel_velocity_left_mps) &&
-                      std::isfinite(o.wheel_base_m) && o.wheel_velocity_covariance.allFinite();
-  if (!finite) return InputResult::rejected("non_finite_odometry");
-  if (!(o.wheel_base_m > 0.0)) return InputResult::rejected("invalid_wheel_base");
-  if ((o.wheel_velocity_covariance.diagonal().array() < 0.0).any()) {
-    return InputResult::rejected("invalid_odometry_covariance");
-  }
-  if (!last_odometry_stamp_ns_) {  // first sample: the anchor of the odometry time line
-    last_odometry_stamp_ns_ = o.stamp_ns;
-    return InputResult::ok();
-  }
-  if (o.stamp_ns <= *last_odometry_stamp_ns_) {
-    return InputResult::rejected(o.stamp_ns == *last_odometry_stamp_ns_ ? "duplicate_odometry"
-                                                                        : "out_of_order_odometry");
-  }
-  const double dt_s = ns_to_s(o.stamp_ns - *last_odometry_stamp_ns_);
-  last_odometry_stamp_ns_ = o.stamp_ns;
-  if (dt_s > params_.max_odometry_gap_s) {
-    // The velocities describe only the last period; integrating them over the whole gap would
-    // invent motion. The sample re-anchors the time line and the gap is reported.
-    return InputResult::rejected("odometry_gap");
-  }
+  const OdometryTimeline::Step step = timeline_.advance(o);
+  if (!step.integrate) return step.result;
+  const double dt_s = step.dt_s;
   odom_pose_ = predict_diff_drive(odom_pose_, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
                                   o.wheel_base_m, dt_s)
                    .pose;
@@ -68,15 +51,9 @@ InputResult RangeEkf::predict(const OdometrySample& o) {
 }
 
 InputResult RangeEkf::update(const RangeMeasurement& r) {
-  if (!std::isfinite(r.range_m) || !std::isfinite(r.variance_m2)) {
-    return InputResult::rejected("non_finite_range");
-  }
-  if (!(r.range_m > 0.0) || !(r.variance_m2 > 0.0)) return InputResult::rejected("invalid_range");
-  if (r.beacon_id == kBeaconUnidentified) return InputResult::rejected("unassociated_range");
-  if (map_.empty()) return InputResult::rejected("no_beacon_map");
-  if (!map_.find(r.beacon_id)) return InputResult::rejected("unknown_beacon");
-  if (r.receiver_id >= receivers_.size()) return InputResult::rejected("unknown_receiver");
-  if (last_odometry_stamp_ns_ && r.stamp_ns < *last_odometry_stamp_ns_ - s_to_ns(params_.max_range_age_s)) {
+  if (const InputResult checked = check_range(r, map_, receivers_.size()); !checked.accepted) return checked;
+  if (timeline_.last_stamp_ns() &&
+      r.stamp_ns < *timeline_.last_stamp_ns() - s_to_ns(params_.max_range_age_s)) {
     return InputResult::rejected("stale_range");
   }
 
@@ -106,7 +83,7 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r) {
     case UpdateOutcome::kApplied:
       ekf_.mutable_state().z() = wrap_angle_rad(ekf_.state().z());
       consecutive_gated_ = 0;
-      last_correction_stamp_ns_ = std::max(r.stamp_ns, last_odometry_stamp_ns_.value_or(r.stamp_ns));
+      last_correction_stamp_ns_ = std::max(r.stamp_ns, timeline_.last_stamp_ns().value_or(r.stamp_ns));
       return InputResult::ok();
     case UpdateOutcome::kSingularInnovation:
       return InputResult::rejected("singular_innovation");
@@ -171,13 +148,13 @@ void RangeEkf::try_initialize() {
   initialized_ = true;
   consecutive_gated_ = 0;
   last_correction_stamp_ns_ = std::max(window_.back().range.stamp_ns,
-                                       last_odometry_stamp_ns_.value_or(window_.back().range.stamp_ns));
+                                       timeline_.last_stamp_ns().value_or(window_.back().range.stamp_ns));
 }
 
 std::optional<PoseEstimate> RangeEkf::estimate() const {
-  if (!initialized_ || !last_odometry_stamp_ns_) return std::nullopt;
+  if (!initialized_ || !timeline_.last_stamp_ns()) return std::nullopt;
   PoseEstimate e;
-  e.stamp_ns = *last_odometry_stamp_ns_;
+  e.stamp_ns = *timeline_.last_stamp_ns();
   e.pose_map_base = ekf_.state();
   e.covariance = ekf_.covariance();
   e.status = status();
@@ -186,7 +163,7 @@ std::optional<PoseEstimate> RangeEkf::estimate() const {
 
 PoseStatus RangeEkf::status() const {
   if (!initialized_) return PoseStatus::kInitializing;
-  return staleness_.classify(last_odometry_stamp_ns_.value_or(last_correction_stamp_ns_),
+  return staleness_.classify(timeline_.last_stamp_ns().value_or(last_correction_stamp_ns_),
                              last_correction_stamp_ns_);
 }
 

@@ -9,6 +9,7 @@
 
 #include "beaconloc/core/estimator.hpp"
 #include "beaconloc/core/filters/ekf.hpp"
+#include "beaconloc/core/odometry_timeline.hpp"
 
 namespace beaconloc {
 
@@ -54,7 +55,7 @@ class RangeEkf final : public Estimator {
   BeaconMap map_;
   Ekf<3> ekf_;
   bool initialized_ = false;
-  std::optional<StampNs> last_odometry_stamp_ns_;
+  OdometryTimeline timeline_;
   StampNs last_correction_stamp_ns_ = 0;
   Pose2 odom_pose_ = Pose2::Zero();  // dead-reckoned, odometry frame
   std::deque<BufferedRange> window_;

@@ -56,6 +56,10 @@ class Estimator {
   virtual PoseStatus status() const = 0;
 };
 
+// The checks every range-based estimator makes of a range: finite, positive, from an identified
+// beacon of the map, to a receiver the robot has. Accepted, or the typed rejection.
+InputResult check_range(const RangeMeasurement& range, const BeaconMap& map, std::size_t receiver_count);
+
 // Status policy shared by estimators: how long without a fused range the pose stays OK.
 struct StalenessPolicy {
   StampNs degraded_after_ns = 1'000'000'000;  // 5 missed beacon slots

@@ -1,0 +1,265 @@
+#include "duhl_estimator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "beaconloc/core/estimator_registry.hpp"
+#include "beaconloc/core/models/diff_drive_motion.hpp"
+
+namespace beaconloc::duhl {
+namespace {
+
+ReceiverRing ring_of(const EstimatorConfig& config) {
+  // The UHL needs the three receivers of eq. 1 on one circle; take its radius from the robot.
+  ReceiverRing ring;
+  if (!config.receivers.receivers_base_m.empty()) ring.radius_m = config.receivers.receivers_base_m[0].norm();
+  ring.height_m = config.receivers.receiver_height_m;
+  return ring;
+}
+
+bool three_on_a_circle(const EstimatorConfig& config) {
+  const ReceiverRing ring = ring_of(config);
+  if (config.receivers.size() != 3 || !(ring.radius_m > 0.0)) return false;
+  for (int l = 0; l < 3; ++l) {
+    if ((config.receivers.receivers_base_m[l] - ring.receiver(l)).norm() > 1e-6) return false;
+  }
+  return true;
+}
+
+UhlOptions uhl_options(const EstimatorConfig& config) {
+  UhlOptions o;
+  const ReceiverRing ring = ring_of(config);
+  o.receiver_radius_m = ring.radius_m;
+  o.receiver_height_m = ring.height_m;
+  o.collinear_threshold_m = config.parameter("uhl_collinear_threshold_m", o.collinear_threshold_m);
+  return o;
+}
+
+Pose2 pose_difference(const Pose2& a, const Pose2& b) {
+  Pose2 d = a - b;
+  d.z() = wrap_angle_rad(d.z());
+  return d;
+}
+
+}  // namespace
+
+Cov3 uhl_observation_covariance(const std::vector<TxDistances>& txs,
+                                const std::vector<DistanceCov>& covariances, const UhlOptions& options) {
+  Cov3 r = Cov3::Zero();
+  const double h = 1e-4;  // m: well above rounding, well below the distances' noise
+  for (std::size_t i = 0; i < txs.size(); ++i) {
+    Eigen::Matrix3d j;  // J_z,q^i
+    for (int l = 0; l < 3; ++l) {
+      auto hi = txs, lo = txs;
+      hi[i].distances_m(l) += h;
+      lo[i].distances_m(l) -= h;
+      const UhlSolution a = solve_uhl(hi, options), b = solve_uhl(lo, options);
+      j.col(l) =
+          a.ok && b.ok ? Eigen::Vector3d(pose_difference(a.pose, b.pose) / (2 * h)) : Eigen::Vector3d::Zero();
+    }
+    r += j * covariances[i] * j.transpose();
+  }
+  return r;
+}
+
+DuhlParameters DuhlParameters::from(const EstimatorConfig& c) {
+  DuhlParameters p;
+  p.uhl = uhl_options(c);
+  p.discard_variance_m2 = c.parameter("discard_variance_m2", p.discard_variance_m2);
+  p.observation_nis_gate = c.parameter("observation_nis_gate", p.observation_nis_gate);
+  p.max_odometry_gap_s = c.parameter("max_odometry_gap_s", p.max_odometry_gap_s);
+  p.reinitialize_after_gated =
+      static_cast<int>(c.parameter("reinitialize_after_gated", p.reinitialize_after_gated));
+  p.discard_variance_m2 = c.parameter("discard_variance_m2", p.discard_variance_m2);
+  return p;
+}
+
+Duhl::Duhl(const EstimatorConfig& config)
+    : ring_(ring_of(config)), params_(DuhlParameters::from(config)), timeline_(params_.max_odometry_gap_s) {
+  if (!three_on_a_circle(config)) {
+    throw std::invalid_argument(
+        "duhl needs three receivers on a circle at 0, 120, 240 degrees (seed 000 eq. 1)");
+  }
+}
+
+InputResult Duhl::predict(const OdometrySample& o) {
+  const OdometryTimeline::Step step = timeline_.advance(o);
+  if (!step.integrate) return step.result;
+  const Eigen::Matrix2d u =
+      o.wheel_velocity_covariance + params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity();
+  if (initialized_) {  // eq. 14, 16
+    const DiffDrivePrediction p = predict_diff_drive(ekf_.state(), o.wheel_velocity_right_mps,
+                                                     o.wheel_velocity_left_mps, o.wheel_base_m, step.dt_s);
+    ekf_.predict(p.pose, p.jacobian_pose, p.jacobian_wheels * u * p.jacobian_wheels.transpose());
+  }
+  for (auto it = available_.begin(); it != available_.end();) {
+    const double z = map_.find(it->first)->position_map_m.z() - ring_.height_m;
+    const DistancePrediction p =
+        predict_distances(it->second.q, z, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
+                          o.wheel_base_m, step.dt_s, ring_);
+    it->second.q = p.q;  // eq. 23
+    it->second.covariance = p.jacobian_q * it->second.covariance * p.jacobian_q.transpose() +
+                            p.jacobian_wheels * u * p.jacobian_wheels.transpose();  // eq. 24
+    // Eq. 31-32: discard a Tx whose distances have grown too uncertain.
+    if (it->second.covariance.diagonal().maxCoeff() > params_.discard_variance_m2) {
+      it = available_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  if (pending_observation_) observe();
+  return InputResult::ok();
+}
+
+InputResult Duhl::update(const RangeMeasurement& r) {
+  if (const InputResult checked = check_range(r, map_, 3); !checked.accepted) return checked;
+  const Eigen::Vector3d& tx = map_.find(r.beacon_id)->position_map_m;
+  auto it = available_.find(r.beacon_id);
+  if (it == available_.end()) {
+    TxEstimate fresh;
+    if (initialized_) {  // eq. 28-29, then eq. 30
+      const DistanceInit init = initial_distances(ekf_.state(), ekf_.covariance(), tx, ring_);
+      fresh = {init.q, init.covariance};
+    } else {
+      // No pose yet: the measured distance stands for the three, the unmeasured ones loosely.
+      fresh.q = Distances::Constant(r.range_m);
+      fresh.covariance = std::pow(params_.unmeasured_sigma_m, 2) * DistanceCov::Identity();
+    }
+    it = available_.emplace(r.beacon_id, fresh).first;
+  }
+  // Eq. 25-27 for the one receiver this range is from (R diagonal: one scalar update per
+  // receiver is the same as the three at once), Joseph form.
+  Ekf<3> q_filter;
+  q_filter.reset(it->second.q, it->second.covariance);
+  Eigen::Matrix<double, 1, 3> h = Eigen::Matrix<double, 1, 3>::Zero();
+  h(r.receiver_id) = 1.0;
+  const UpdateResult result =
+      q_filter.update<1>(Eigen::Matrix<double, 1, 1>(r.range_m - it->second.q(r.receiver_id)), h,
+                         Eigen::Matrix<double, 1, 1>(r.variance_m2), 1e12);
+  if (result.outcome != UpdateOutcome::kApplied) return InputResult::rejected("singular_innovation");
+  it->second.q = q_filter.state();
+  it->second.covariance = q_filter.covariance();
+  pending_observation_ = true;  // the UHL runs at the next odometry step, once all receivers are in
+  return InputResult::ok();
+}
+
+void Duhl::observe() {
+  pending_observation_ = false;
+  if (available_.size() < 2) return;
+  std::vector<TxDistances> txs;
+  std::vector<DistanceCov> covariances;
+  for (const auto& [id, e] : available_) {
+    txs.push_back({map_.find(id)->position_map_m, e.q});
+    covariances.push_back(e.covariance);
+  }
+  const UhlSolution z = solve_uhl(txs, params_.uhl);
+  if (!z.ok) return;
+  const Cov3 r =
+      uhl_observation_covariance(txs, covariances, params_.uhl) + 1e-9 * Cov3::Identity();  // eq. 21
+  const StampNs now = *timeline_.last_stamp_ns();
+  if (!initialized_) {
+    ekf_.reset(z.pose, r);
+    initialized_ = true;
+    last_correction_stamp_ns_ = now;
+    return;
+  }
+  // Eq. 17-20 with J_h,x = I.
+  const Eigen::Vector3d innovation = pose_difference(z.pose, ekf_.state());
+  const UpdateResult result =
+      ekf_.update<3>(innovation, Eigen::Matrix3d::Identity(), r, params_.observation_nis_gate);
+  if (result.outcome == UpdateOutcome::kApplied) {
+    ekf_.mutable_state().z() = wrap_angle_rad(ekf_.state().z());
+    last_correction_stamp_ns_ = now;
+    consecutive_gated_ = 0;
+  } else if (params_.reinitialize_after_gated > 0 &&
+             ++consecutive_gated_ >= params_.reinitialize_after_gated) {
+    ekf_.reset(z.pose, r);  // the UHL and the filter disagree for too long: trust the beacons
+    last_correction_stamp_ns_ = now;
+    consecutive_gated_ = 0;
+  }
+}
+
+std::optional<PoseEstimate> Duhl::estimate() const {
+  if (!initialized_ || !timeline_.last_stamp_ns()) return std::nullopt;
+  return PoseEstimate{*timeline_.last_stamp_ns(), ekf_.state(), ekf_.covariance(), status()};
+}
+
+PoseStatus Duhl::status() const {
+  if (!initialized_) return PoseStatus::kInitializing;
+  return staleness_.classify(timeline_.last_stamp_ns().value_or(last_correction_stamp_ns_),
+                             last_correction_stamp_ns_);
+}
+
+UhlLast2::UhlLast2(const EstimatorConfig& config)
+    : ring_(ring_of(config)), uhl_(uhl_options(config)), timeline_(0.2) {
+  if (!three_on_a_circle(config)) {
+    throw std::invalid_argument(
+        "uhl_last2 needs three receivers on a circle at 0, 120, 240 degrees (seed 000 eq. 1)");
+  }
+}
+
+InputResult UhlLast2::predict(const OdometrySample& o) {
+  const OdometryTimeline::Step step = timeline_.advance(o);
+  if (!step.result.accepted) return step.result;
+  if (!pending_) return InputResult::ok();
+  pending_ = false;
+  // The last two Txs heard by all three receivers.
+  std::vector<TxDistances> txs;
+  std::vector<DistanceCov> covariances;
+  for (auto it = firings_.rbegin(); it != firings_.rend() && txs.size() < 2; ++it) {
+    if (!(it->heard[0] && it->heard[1] && it->heard[2])) continue;
+    txs.push_back({map_.find(it->beacon_id)->position_map_m, it->d});
+    covariances.push_back(it->variance_m2 * DistanceCov::Identity());
+  }
+  if (txs.size() < 2) return InputResult::ok();
+  const UhlSolution z = solve_uhl(txs, uhl_);
+  if (!z.ok) return InputResult::ok();
+  last_ = PoseEstimate{o.stamp_ns, z.pose,
+                       uhl_observation_covariance(txs, covariances, uhl_) + 1e-9 * Cov3::Identity(),
+                       PoseStatus::kOk};
+  last_solution_stamp_ns_ = o.stamp_ns;
+  return InputResult::ok();
+}
+
+InputResult UhlLast2::update(const RangeMeasurement& r) {
+  if (const InputResult checked = check_range(r, map_, 3); !checked.accepted) return checked;
+  // A new firing when this Tx is not the newest, or this receiver was already heard from it.
+  if (firings_.empty() || firings_.back().beacon_id != r.beacon_id || firings_.back().heard[r.receiver_id]) {
+    firings_.erase(std::remove_if(firings_.begin(), firings_.end(),
+                                  [&](const Firing& f) { return f.beacon_id == r.beacon_id; }),
+                   firings_.end());
+    firings_.push_back({r.beacon_id, Distances::Zero()});
+    if (firings_.size() > 8) firings_.erase(firings_.begin());
+  }
+  firings_.back().d(r.receiver_id) = r.range_m;
+  firings_.back().heard[r.receiver_id] = true;
+  firings_.back().variance_m2 = r.variance_m2;
+  pending_ = true;
+  return InputResult::ok();
+}
+
+std::optional<PoseEstimate> UhlLast2::estimate() const {
+  if (!last_ || !timeline_.last_stamp_ns()) return std::nullopt;
+  PoseEstimate e = *last_;  // the last UHL pose, held until the next
+  e.stamp_ns = *timeline_.last_stamp_ns();
+  e.status = status();
+  return e;
+}
+
+PoseStatus UhlLast2::status() const {
+  if (!last_) return PoseStatus::kInitializing;
+  return staleness_.classify(timeline_.last_stamp_ns().value_or(last_solution_stamp_ns_),
+                             last_solution_stamp_ns_);
+}
+
+namespace {
+BEACONLOC_REGISTER_ESTIMATOR(
+    "duhl", "seed 000 DUHL: EKF corrected by the UHL pose of the dynamically estimated distances",
+    [](const EstimatorConfig& config) { return std::make_unique<Duhl>(config); });
+BEACONLOC_REGISTER_ESTIMATOR("uhl_last2", "seed 000's baseline: UHL on the last two Txs' measured distances",
+                             [](const EstimatorConfig& config) {
+                               return std::make_unique<UhlLast2>(config);
+                             });
+}  // namespace
+
+}  // namespace beaconloc::duhl

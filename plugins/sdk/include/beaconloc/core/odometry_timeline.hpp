@@ -1,0 +1,28 @@
+#pragma once
+// The checks every estimator makes of an odometry sample before integrating it, and the time
+// line it keeps: finite values, a positive wheel base, a sane covariance, stamps that move
+// forward, and no integration across a gap (the velocities describe only the last period).
+#include <optional>
+
+#include "beaconloc/core/estimator.hpp"
+
+namespace beaconloc {
+
+class OdometryTimeline {
+ public:
+  explicit OdometryTimeline(double max_gap_s) : max_gap_s_(max_gap_s) {}
+
+  struct Step {
+    InputResult result;      // accepted, or the typed rejection
+    double dt_s = 0.0;       // interval to integrate over; 0 for the first sample (the anchor)
+    bool integrate = false;  // accepted and not the anchor
+  };
+  Step advance(const OdometrySample& o);
+  std::optional<StampNs> last_stamp_ns() const { return last_stamp_ns_; }
+
+ private:
+  double max_gap_s_;
+  std::optional<StampNs> last_stamp_ns_;
+};
+
+}  // namespace beaconloc
