@@ -1,11 +1,14 @@
 // UHL (seed 000, Section II-B): exact on noise-free distances for triangle, grid and collinear
 // Tx layouts, all 12 orientations of the paper, robot inside and outside the Tx polygon.
-// (The static accuracy with sigma_d = 0.01 m against the paper's 0.02 m / 1 degree is issue 4's,
-// still open: measured 1.6-3.5 degrees mean heading error, see its notes.)
+// With sigma_d = 0.01 m (Sec. V), 12 orientations x 500 runs: within the paper's 0.02 m mean
+// position error, and a mean heading error near the Cramer-Rao bound of the geometry. The paper's
+// 1 degree is below that bound for these layouts (triangle inside: bound ~2.3 degrees mean), so it
+// cannot have come from 0.01 m of static noise per distance.
 #include "duhl/uhl.hpp"
 
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
 #include <random>
 
 #include "beaconloc/core/models/range_model.hpp"
@@ -73,6 +76,55 @@ TEST(Uhl, CentreRangeIsTheIsotropicArrayMean) {
   const auto d = measure(truth, {kGrid[5]});
   const double rho = uhl_centre_range(d[0], UhlOptions{});
   EXPECT_NEAR(rho, (kGrid[5] - Eigen::Vector3d(0.4, -0.7, 0.0)).norm(), 1e-12);
+}
+
+// Cramer-Rao bound of the heading from the 3N distances (sigma each), averaged over the 12 headings.
+double heading_bound_deg(const std::vector<Eigen::Vector3d>& txs, const Eigen::Vector2d& position,
+                         double sigma) {
+  const auto rx = ReceiverArray::on_circle(0.19, 3);
+  double sum = 0.0;
+  for (int k = 0; k < 12; ++k) {
+    const Pose2 pose(position.x(), position.y(), k * M_PI / 6.0);
+    Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+    for (const auto& t : txs) {
+      for (int l = 0; l < 3; ++l) {
+        const Eigen::RowVector3d j = predict_range(pose, rx.receivers_base_m[l], 0.0, t).jacobian_pose;
+        information += j.transpose() * j / (sigma * sigma);
+      }
+    }
+    sum += std::sqrt(information.inverse()(2, 2)) * 180.0 / M_PI;
+  }
+  return sum / 12.0;
+}
+
+TEST(Uhl, StaticAccuracyWithThePapersNoiseNearTheCramerRaoBound) {
+  std::mt19937_64 rng(2013);
+  const double sigma = 0.01;
+  for (const auto& [name, txs, position] :
+       std::vector<std::tuple<const char*, std::vector<Eigen::Vector3d>, Eigen::Vector2d>>{
+           {"triangle, inside", kTriangle, {1.0, 0.6}}, {"grid, inside", kGrid, {1.2, 0.7}}}) {
+    double sum_position = 0.0, sum_heading = 0.0;
+    int n = 0;
+    for (int k = 0; k < 12; ++k) {
+      const Pose2 truth(position.x(), position.y(), wrap_angle_rad(k * M_PI / 6.0));
+      for (int run = 0; run < 500; ++run) {
+        const UhlSolution s = solve_uhl(measure(truth, txs, sigma, &rng));
+        ASSERT_TRUE(s.ok) << s.failure;
+        sum_position += (s.pose.head<2>() - truth.head<2>()).norm();
+        sum_heading += std::abs(wrap_angle_rad(s.pose.z() - truth.z())) * 180.0 / M_PI;
+        ++n;
+      }
+    }
+    // A Gaussian's mean absolute error is sqrt(2 / pi) = 0.80 of its standard deviation.
+    const double bound_mean_deg = std::sqrt(2.0 / M_PI) * heading_bound_deg(txs, position, sigma);
+    std::printf(
+        "UHL, %s, sigma_d 0.01 m, 12 x 500 runs: mean position error %.4f m, mean heading error %.2f deg "
+        "(Cramer-Rao bound %.2f deg; the paper: 1 deg)\n",
+        name, sum_position / n, sum_heading / n, bound_mean_deg);
+    EXPECT_LE(sum_position / n, 0.02) << name;                  // the paper's figure
+    EXPECT_LE(sum_heading / n, 1.25 * bound_mean_deg) << name;  // within 25 % of the best possible
+    EXPECT_GT(bound_mean_deg, 1.0) << name;                     // why the paper's 1 degree is out of reach
+  }
 }
 
 TEST(Uhl, RefusesWhatItCannotSolve) {
