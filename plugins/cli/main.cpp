@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <thread>
 
@@ -11,8 +12,10 @@
 #include "decoder_participant.hpp"
 #include "diagnostics_recorder.hpp"
 #include "localizer_participant.hpp"
+#include "offline_run.hpp"
 #include "pipeline.hpp"
 #include "pose_recorder.hpp"
+#include "sim/scenario_yaml.hpp"
 
 namespace beaconloc::cli {
 namespace {
@@ -171,6 +174,25 @@ int run(int argc, char** argv) {
   eval->add_option("--max-truth-gap-s", max_truth_gap_s, "interpolate truth over gaps up to this long")
       ->check(kPositive);
 
+  std::vector<std::string> accuracy_scenarios, accuracy_estimators{"range_ekf"}, accuracy_parameters;
+  int accuracy_seeds = 10;
+  std::uint64_t accuracy_first_seed = 1;
+  double accuracy_settle_s = 0.0;
+  std::string accuracy_out;
+  auto* accuracy = app.add_subcommand(
+      "accuracy",
+      "accuracy over seeds, without DDS: a markdown table of mean and spread per scenario and estimator");
+  accuracy->add_option("--scenario", accuracy_scenarios, "scenario YAML (repeatable)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  accuracy->add_option("--estimator", accuracy_estimators, "estimator (repeatable; default range_ekf)");
+  accuracy->add_option("--seeds", accuracy_seeds, "number of seeds")->check(CLI::Range(1, 1000));
+  accuracy->add_option("--first-seed", accuracy_first_seed, "first seed");
+  accuracy->add_option("--settle-s", accuracy_settle_s, "seconds after the first pose not scored")
+      ->check(kNonNegative);
+  accuracy->add_option("--param", accuracy_parameters, "estimator parameter NAME=VALUE for every estimator");
+  accuracy->add_option("--out", accuracy_out, "also write the table to this file");
+
   auto* monitor = app.add_subcommand(
       "monitor", "print the poses on the bus each second; with --truth, the accuracy at the end");
   add_dds_options(monitor, dds_options);
@@ -217,6 +239,30 @@ int run(int argc, char** argv) {
       const Metrics m = evaluate_files(truth_file, estimate_file, out_dir, beacons_file, max_truth_gap_s);
       std::cout << format_metrics(m) << "\nwrote " << out_dir << "/metrics.json, trajectory.svg, error.svg\n";
       return m.samples ? 0 : 1;
+    }
+    if (accuracy->parsed()) {
+      std::vector<AccuracyRow> rows;
+      for (const auto& file : accuracy_scenarios) {
+        const sim::Scenario scenario = sim::load_scenario_file(file);
+        for (const auto& estimator : accuracy_estimators) {
+          AccuracyRow row{scenario.name, estimator, {}};
+          for (int k = 0; k < accuracy_seeds; ++k) {
+            row.runs.push_back(run_scenario_offline(scenario,
+                                                    accuracy_first_seed + static_cast<std::uint64_t>(k),
+                                                    estimator, accuracy_parameters, accuracy_settle_s)
+                                   .metrics);
+          }
+          rows.push_back(row);
+        }
+      }
+      const std::string table = accuracy_table_markdown(rows);
+      std::cout << table;
+      if (!accuracy_out.empty()) {
+        std::ofstream out(accuracy_out);
+        out << table;
+        if (!out.flush()) throw std::runtime_error("writing '" + accuracy_out + "' failed");
+      }
+      return 0;
     }
     if (monitor->parsed()) {
       PoseRecorder recorder(dds_options);

@@ -22,11 +22,13 @@ std::pair<int, std::string> beaconloc(std::vector<std::string> args) {
 TEST(Cli, HelpEverywhere) {
   auto [code, out] = beaconloc({"--help"});
   EXPECT_EQ(code, 0);
-  for (const char* sub : {"gateway", "decoder", "localizer", "demo", "run", "eval", "monitor"}) {
+  for (const char* sub : {"gateway", "decoder", "localizer", "demo", "run", "eval", "accuracy", "monitor"}) {
     EXPECT_NE(out.find(sub), std::string::npos) << sub;
     auto [sub_code, sub_out] = beaconloc({sub, "--help"});
     EXPECT_EQ(sub_code, 0) << sub;
-    EXPECT_NE(sub_out.find(std::string(sub) == "eval" ? "--truth" : "--domain"), std::string::npos) << sub;
+    const std::string sub_name = sub;
+    const char* expected = sub_name == "eval" ? "--truth" : sub_name == "accuracy" ? "--seeds" : "--domain";
+    EXPECT_NE(sub_out.find(expected), std::string::npos) << sub;
   }
 }
 
@@ -84,6 +86,19 @@ TEST(Cli, ParticipantsStopCleanlyOnSigintAndSigterm) {
     }
   }
   std::remove("/tmp/beaconloc-cli-signal.log");
+}
+
+TEST(Cli, AccuracyPrintsATableOverSeeds) {
+  auto [code, out] = beaconloc({"accuracy", "--scenario",
+                                std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/default.yaml",
+                                "--estimator", "range_ekf", "--seeds", "3"});
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_NE(out.find("| default | range_ekf | 3 | "), std::string::npos) << out;
+  auto [bad_code, bad_out] = beaconloc(
+      {"accuracy", "--scenario", std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/default.yaml",
+       "--estimator", "nope"});
+  EXPECT_EQ(bad_code, 2);
+  EXPECT_NE(bad_out.find("nope"), std::string::npos) << bad_out;
 }
 
 TEST(Cli, DemoEndsWithThePositionRmsAgainstGroundTruth) {
