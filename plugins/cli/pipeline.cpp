@@ -374,12 +374,7 @@ EstimatorConfig LocalizerSettings::config(const std::optional<ReceiverArray>& fa
     c.receivers = ReceiverArray::on_circle(receiver_radius_m, receiver_count);
     c.receivers.receiver_height_m = receiver_height_m;
   }
-  for (const auto& p : parameters) {
-    const auto eq = p.find('=');
-    if (eq == std::string::npos || eq == 0)
-      throw std::invalid_argument("--param '" + p + "' is not NAME=VALUE");
-    c.parameters[p.substr(0, eq)] = parse_double(p.substr(eq + 1), "--param '" + p + "'");
-  }
+  c.parameters = parse_estimator_parameters(parameters, "--param");
   return c;
 }
 

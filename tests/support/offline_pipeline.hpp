@@ -1,6 +1,6 @@
 #pragma once
-// The pipeline without DDS, for unit and accuracy tests: simulated source -> TofDecoder ->
-// LocalizerCore, with every pose compared to the simulator's truth.
+// The pipeline without DDS for unit tests (OfflineStack, simulate: plugins/eval/offline), with
+// the per-step statistics the tests assert on.
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <optional>
@@ -8,47 +8,12 @@
 #include <vector>
 
 #include "beaconloc/core/pose_error.hpp"
-#include "localizer_core.hpp"
-#include "sim/sim_source.hpp"
-#include "tof_decoder.hpp"
+#include "offline_run.hpp"
 
 namespace beaconloc::testing {
 
-inline std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed,
-                                         double duration_s) {
-  sim::SimSource source(scenario, seed);
-  std::vector<SourceEvent> events;
-  source.advance(s_to_ns(duration_s), events);
-  return events;
-}
-
-// Decoder and localizer cores wired as the participants wire them, knowing the scenario's map.
-struct OfflineStack {
-  explicit OfflineStack(const sim::Scenario& scenario, const std::string& estimator = "range_ekf")
-      : localizer(estimator, config_for(scenario)) {
-    localizer.set_beacon_map(BeaconMap(scenario.beacons));
-    decoder.set_beacon_map(BeaconMap(scenario.beacons));
-  }
-  // One simulated event in; the pose the localizer would publish, on odometry events.
-  std::optional<LocalizerOutput> feed(const std::string& robot_id, const SourceEvent& e) {
-    if (e.kind == SourceEvent::Kind::kTof) {
-      if (const auto out = decoder.decode(robot_id, e.tof); out.range) {
-        localizer.on_range(robot_id, out.range->range);
-      }
-      return std::nullopt;
-    }
-    if (e.kind != SourceEvent::Kind::kOdometry) return std::nullopt;
-    return localizer.on_odometry(robot_id, e.odometry);
-  }
-  static EstimatorConfig config_for(const sim::Scenario& scenario) {
-    EstimatorConfig config;
-    config.receivers = scenario.receivers;
-    return config;
-  }
-
-  LocalizerCore localizer;
-  TofDecoder decoder;
-};
+using beaconloc::OfflineStack;
+using beaconloc::simulate;
 
 struct OfflineRun {
   PoseErrorAccumulator error;  // over every pose after start_after_s + settle_s

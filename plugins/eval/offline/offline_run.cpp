@@ -5,42 +5,54 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "localizer_core.hpp"
 #include "sim/sim_source.hpp"
-#include "tof_decoder.hpp"
 
 namespace beaconloc {
+
+namespace {
+
+EstimatorConfig config_for(const sim::Scenario& scenario, const std::map<std::string, double>& parameters) {
+  EstimatorConfig config;
+  config.receivers = scenario.receivers;
+  config.parameters = parameters;
+  return config;
+}
+
+}  // namespace
+
+std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed, double duration_s) {
+  sim::SimSource source(scenario, seed);
+  std::vector<SourceEvent> events;
+  source.advance(s_to_ns(duration_s), events);
+  return events;
+}
+
+OfflineStack::OfflineStack(const sim::Scenario& scenario, const std::string& estimator,
+                           const std::map<std::string, double>& parameters)
+    : localizer(estimator, config_for(scenario, parameters)) {
+  localizer.set_beacon_map(BeaconMap(scenario.beacons));
+  decoder.set_beacon_map(BeaconMap(scenario.beacons));
+}
+
+std::optional<LocalizerOutput> OfflineStack::feed(const std::string& robot_id, const SourceEvent& e) {
+  if (e.kind == SourceEvent::Kind::kTof) {
+    if (const auto out = decoder.decode(robot_id, e.tof); out.range)
+      localizer.on_range(robot_id, out.range->range);
+    return std::nullopt;
+  }
+  if (e.kind != SourceEvent::Kind::kOdometry) return std::nullopt;
+  return localizer.on_odometry(robot_id, e.odometry);
+}
 
 OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64_t seed,
                                       const std::string& estimator,
                                       const std::vector<std::string>& parameters, double settle_s) {
-  EstimatorConfig config;
-  config.receivers = scenario.receivers;
-  for (const auto& p : parameters) {
-    const auto eq = p.find('=');
-    if (eq == std::string::npos) throw std::invalid_argument("parameter '" + p + "' is not NAME=VALUE");
-    config.parameters[p.substr(0, eq)] = std::stod(p.substr(eq + 1));
-  }
-  LocalizerCore localizer(estimator, config);
-  TofDecoder decoder;
-  const BeaconMap map(scenario.beacons);
-  localizer.set_beacon_map(map);
-  decoder.set_beacon_map(map);
-  sim::SimSource source(scenario, seed);
-  std::vector<SourceEvent> events;
-  source.advance(s_to_ns(scenario.duration_s), events);
-
+  OfflineStack stack(scenario, estimator, parse_estimator_parameters(parameters, "parameter"));
   TruthTrack truth;
   std::vector<EstimateRow> rows;
-  for (const auto& e : events) {
-    if (e.kind == SourceEvent::Kind::kTof) {
-      if (const auto out = decoder.decode("robot", e.tof); out.range)
-        localizer.on_range("robot", out.range->range);
-    } else if (e.kind == SourceEvent::Kind::kOdometry) {
-      truth.add(e.stamp_ns, e.truth_map_base);
-      if (auto pose = localizer.on_odometry("robot", e.odometry))
-        rows.push_back({"robot", pose->estimate, estimator});
-    }
+  for (const auto& e : simulate(scenario, seed, scenario.duration_s)) {
+    if (e.kind == SourceEvent::Kind::kOdometry) truth.add(e.stamp_ns, e.truth_map_base);
+    if (auto pose = stack.feed("robot", e)) rows.push_back({"robot", pose->estimate, estimator});
   }
   OfflineRunResult result;
   result.poses = rows.size();

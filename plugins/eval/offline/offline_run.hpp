@@ -3,14 +3,33 @@
 // cores (the same code the participants run), every pose scored against the simulator's truth.
 // For accuracy tables over many seeds: deterministic, and as fast as the estimator.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "beaconloc/core/estimator.hpp"
 #include "evaluation.hpp"
+#include "localizer_core.hpp"
 #include "sim/scenario.hpp"
+#include "source.hpp"
+#include "tof_decoder.hpp"
 
 namespace beaconloc {
+
+// Every event of a scenario up to duration_s, in stamp order.
+std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed, double duration_s);
+
+// Decoder and localizer cores wired as the participants wire them, knowing the scenario's map
+// and receivers.
+struct OfflineStack {
+  explicit OfflineStack(const sim::Scenario& scenario, const std::string& estimator = "range_ekf",
+                        const std::map<std::string, double>& parameters = {});
+  // One simulated event in; the pose the localizer would publish, on odometry events.
+  std::optional<LocalizerOutput> feed(const std::string& robot_id, const SourceEvent& e);
+
+  LocalizerCore localizer;
+  TofDecoder decoder;
+};
 
 struct OfflineRunResult {
   Metrics metrics;
@@ -18,6 +37,7 @@ struct OfflineRunResult {
 };
 
 // Scores poses from settle_s after the first one (the first global fix is not tracking).
+// parameters: NAME=VALUE items; std::invalid_argument names a bad one.
 OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64_t seed,
                                       const std::string& estimator,
                                       const std::vector<std::string>& parameters, double settle_s = 0.0);

@@ -1,6 +1,8 @@
 #include "beaconloc/core/estimator.hpp"
 
 #include <cmath>
+#include <cstdlib>
+#include <stdexcept>
 
 #include "beaconloc/core/estimator_registry.hpp"
 
@@ -18,6 +20,25 @@ const char* to_string(PoseStatus s) {
       return "lost";
   }
   return "unknown";
+}
+
+std::map<std::string, double> parse_estimator_parameters(const std::vector<std::string>& items,
+                                                         const std::string& option_name) {
+  std::map<std::string, double> out;
+  for (const auto& item : items) {
+    const auto eq = item.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      throw std::invalid_argument(option_name + " '" + item + "' is not NAME=VALUE");
+    }
+    const std::string value = item.substr(eq + 1);
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(v)) {
+      throw std::invalid_argument(option_name + " '" + item + "': '" + value + "' is not a number");
+    }
+    out[item.substr(0, eq)] = v;
+  }
+  return out;
 }
 
 InputResult check_range(const RangeMeasurement& r, const BeaconMap& map, std::size_t receiver_count) {

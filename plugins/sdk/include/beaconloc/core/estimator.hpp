@@ -43,6 +43,11 @@ struct EstimatorConfig {
   }
 };
 
+// NAME=VALUE items (the --param options) as estimator parameters. Throws std::invalid_argument
+// naming the option and the item that is not NAME=VALUE or whose value is not a finite number.
+std::map<std::string, double> parse_estimator_parameters(const std::vector<std::string>& items,
+                                                         const std::string& option_name);
+
 class Estimator {
  public:
   virtual ~Estimator() = default;
