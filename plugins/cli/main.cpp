@@ -178,6 +178,7 @@ int run(int argc, char** argv) {
   int accuracy_seeds = 10;
   std::uint64_t accuracy_first_seed = 1;
   double accuracy_settle_s = 0.0;
+  std::optional<double> accuracy_odometry_k_v_m;
   std::string accuracy_out;
   auto* accuracy = app.add_subcommand(
       "accuracy",
@@ -191,6 +192,10 @@ int run(int argc, char** argv) {
   accuracy->add_option("--settle-s", accuracy_settle_s, "seconds after the first pose not scored")
       ->check(kNonNegative);
   accuracy->add_option("--param", accuracy_parameters, "estimator parameter NAME=VALUE for every estimator");
+  accuracy
+      ->add_option("--odometry-k-v-m", accuracy_odometry_k_v_m,
+                   "replace the scenarios' odometry noise k_v (sigma_v^2 = k_v |v| / dT per wheel)")
+      ->check(kNonNegative);
   accuracy->add_option("--out", accuracy_out, "also write the table to this file");
 
   auto* monitor = app.add_subcommand(
@@ -243,7 +248,8 @@ int run(int argc, char** argv) {
     if (accuracy->parsed()) {
       std::vector<AccuracyRow> rows;
       for (const auto& file : accuracy_scenarios) {
-        const sim::Scenario scenario = sim::load_scenario_file(file);
+        sim::Scenario scenario = sim::load_scenario_file(file);
+        if (accuracy_odometry_k_v_m) scenario.odometry_k_v_m = *accuracy_odometry_k_v_m;
         for (const auto& estimator : accuracy_estimators) {
           AccuracyRow row{scenario.name, estimator, {}};
           for (int k = 0; k < accuracy_seeds; ++k) {

@@ -70,6 +70,34 @@ TEST(Uhl, RecoversNoiseFreePosesForEveryLayoutAndTheTwelveHeadings) {
   }
 }
 
+TEST(Uhl, AnalyticJacobianMatchesNumericWhereTableOneTakesTheImr) {
+  std::mt19937_64 rng(7);
+  const std::vector<Case> cases = {
+      {"triangle, inside", kTriangle, {1.0, 0.6}, UhlMethod::kIndirect},
+      {"triangle, outside", kTriangle, {3.2, 2.1}, UhlMethod::kIndirect},
+      {"grid, inside", kGrid, {0.8, 0.9}, UhlMethod::kIndirect},
+      {"grid, outside", kGrid, {-1.0, 2.5}, UhlMethod::kIndirect},
+  };
+  for (const auto& c : cases) {
+    for (int k = 0; k < 12; ++k) {
+      // Noisy distances: the Jacobian is needed away from the exact geometry too.
+      const auto txs = measure(Pose2(c.position.x(), c.position.y(), k * M_PI / 6.0), c.txs, 0.01, &rng);
+      const UhlSolution s = solve_uhl(txs);
+      ASSERT_TRUE(s.ok);
+      const auto analytic = uhl_jacobian(txs, s);
+      ASSERT_TRUE(analytic) << c.name;
+      const UhlJacobian numeric = uhl_jacobian_numeric(txs);
+      EXPECT_LT((*analytic - numeric).cwiseAbs().maxCoeff(), 1e-6 * (1.0 + numeric.cwiseAbs().maxCoeff()))
+          << c.name << ", " << 30 * k << " deg\n"
+          << *analytic << "\n"
+          << numeric;
+    }
+  }
+  // Collinear Txs: the other branches of Table I are left to numeric differentiation.
+  const auto collinear = measure(Pose2(1.2, 1.1, 0.3), kCollinear);
+  EXPECT_FALSE(uhl_jacobian(collinear, solve_uhl(collinear)));
+}
+
 TEST(Uhl, CentreRangeIsTheIsotropicArrayMean) {
   // Eq. 11: rho^2 = mean of d_l^2 - r_R^2 equals the squared range from the robot centre.
   const Pose2 truth(0.4, -0.7, 1.3);

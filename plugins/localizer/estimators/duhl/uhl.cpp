@@ -40,6 +40,44 @@ TxLine tx_line(const std::vector<TxDistances>& txs) {
   return line;
 }
 
+// A symmetric positive semi-definite normal matrix is usable when its smallest eigenvalue is not
+// lost in rounding against its largest.
+template <int N>
+bool well_conditioned(const Eigen::Matrix<double, N, N>& normal) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> eig;
+  eig.computeDirect(normal, Eigen::EigenvaluesOnly);
+  return eig.eigenvalues()(0) > 1e-12 * std::max(1.0, eig.eigenvalues()(N - 1));
+}
+
+// The two rows of eq. 4 for Txs i and j: A^{i,j} Phi = b^{i,j} (ERRATA).
+struct EqFourRows {
+  Eigen::Matrix2d a;
+  Eigen::Vector2d b;
+};
+
+double eq_four_k(double r_r) { return 1.0 / (2.0 * std::sqrt(3.0) * r_r); }
+
+EqFourRows eq_four_rows(const TxDistances& ti, const TxDistances& tj, double r_r) {
+  const Eigen::Vector3d& di = ti.distances_m;
+  const Eigen::Vector3d& dj = tj.distances_m;
+  const double k = eq_four_k(r_r);
+  const double dx = tj.tx_map_m.x() - ti.tx_map_m.x(), dy = tj.tx_map_m.y() - ti.tx_map_m.y();
+  EqFourRows rows;
+  rows.a << std::sqrt(3.0) * dx, std::sqrt(3.0) * dy, -dy, dx;
+  rows.b << k * (2 * di(0) * di(0) - di(1) * di(1) - di(2) * di(2) - 2 * dj(0) * dj(0) + dj(1) * dj(1) +
+                 dj(2) * dj(2)),
+      k * (-di(1) * di(1) + di(2) * di(2) + dj(1) * dj(1) - dj(2) * dj(2));
+  return rows;
+}
+
+// d b^{i,j} / d d^i; d b^{i,j} / d d^j is its negative evaluated at d^j.
+Eigen::Matrix<double, 2, 3> eq_four_gradient(const Eigen::Vector3d& d, double r_r) {
+  const double k = eq_four_k(r_r);
+  Eigen::Matrix<double, 2, 3> g;
+  g << 4 * k * d(0), -2 * k * d(1), -2 * k * d(2), 0.0, -2 * k * d(1), 2 * k * d(2);
+  return g;
+}
+
 // Eq. 7 as a function of phi, and its derivative.
 struct Eq7 {
   double a1, a2, a3, b1, b2;
@@ -53,6 +91,11 @@ struct Eq7 {
   }
   double scale() const { return std::abs(a1) + std::abs(a2) + std::abs(a3) + std::abs(b1) + std::abs(b2); }
 };
+
+// Eq. 7-8, with A^T A = [[a1, a3], [a3, a2]] and A^T b = -[b1, b2].
+Eq7 eq7_of(const Eigen::Matrix2d& ata, const Eigen::Vector2d& atb) {
+  return {ata(0, 0), ata(1, 1), ata(0, 1), -atb(0), -atb(1)};
+}
 
 // Real roots of k4 s^4 + k3 s^3 + k2 s^2 + k1 s + k0 (eigenvalues of the companion matrix).
 std::vector<double> real_quartic_roots(double k4, double k3, double k2, double k1, double k0) {
@@ -74,34 +117,22 @@ std::vector<double> real_quartic_roots(double k4, double k3, double k2, double k
 }  // namespace
 
 std::optional<double> uhl_orientation(const std::vector<TxDistances>& txs, const UhlOptions& o) {
-  // Eq. 4: two rows per pair of Txs.
+  // Eq. 4: two rows per pair of Txs, accumulated straight into A^T A and A^T b.
   const int n = static_cast<int>(txs.size());
   if (n < 2) return std::nullopt;
-  Eigen::MatrixXd a(n * (n - 1), 2);
-  Eigen::VectorXd b(n * (n - 1));
-  const double k = 1.0 / (2.0 * std::sqrt(3.0) * o.receiver_radius_m);
-  int row = 0;
+  Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d atb = Eigen::Vector2d::Zero();
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
-      const Eigen::Vector3d& di = txs[i].distances_m;
-      const Eigen::Vector3d& dj = txs[j].distances_m;
-      const double dx = txs[j].tx_map_m.x() - txs[i].tx_map_m.x(),
-                   dy = txs[j].tx_map_m.y() - txs[i].tx_map_m.y();
-      a.row(row) << std::sqrt(3.0) * dx, std::sqrt(3.0) * dy;
-      b(row++) = k * (2 * di(0) * di(0) - di(1) * di(1) - di(2) * di(2) - 2 * dj(0) * dj(0) + dj(1) * dj(1) +
-                      dj(2) * dj(2));
-      a.row(row) << -dy, dx;
-      b(row++) = k * (-di(1) * di(1) + di(2) * di(2) + dj(1) * dj(1) - dj(2) * dj(2));
+      const EqFourRows rows = eq_four_rows(txs[i], txs[j], o.receiver_radius_m);
+      ata += rows.a.transpose() * rows.a;
+      atb += rows.a.transpose() * rows.b;
     }
   }
-  const Eigen::Matrix2d ata = a.transpose() * a;
-  const Eigen::Vector2d atb = a.transpose() * b;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> check(ata);
-  if (!(check.eigenvalues()(0) > 1e-12 * std::max(1.0, check.eigenvalues()(1)))) return std::nullopt;
+  if (!well_conditioned(ata)) return std::nullopt;
   const Eigen::Vector2d phi_pinv = ata.ldlt().solve(atb);  // the pseudoinverse solution of eq. 4
 
-  // Eq. 7-8, with A^T A = [[a1, a3], [a3, a2]] and A^T b = -[b1, b2].
-  const Eq7 eq7{ata(0, 0), ata(1, 1), ata(0, 1), -atb(0), -atb(1)};
+  const Eq7 eq7 = eq7_of(ata, atb);
   const double d = eq7.a1 - eq7.a2;
   const double k4 = d * d + 4 * eq7.a3 * eq7.a3;
   const double k3 = -2 * d * eq7.b2 + 4 * eq7.a3 * eq7.b1;
@@ -140,9 +171,10 @@ std::optional<Eigen::Vector2d> uhl_direct_position(const std::vector<TxDistances
                                                    const UhlOptions& o) {
   // Eq. 10: G_DM [x, y, x^2 + y^2]^T = h_DM, three rows per Tx (ERRATA: every row of h_DM is
   // 0.5 (-(d_l^i)^2 + (x_i - g_l^x)^2 + (y_i - g_l^y)^2 + z_T^2)).
+  // Accumulated as the normal equations G^T G theta = G^T h (3 x 3), checked for rank.
   const int n = static_cast<int>(txs.size());
-  Eigen::MatrixXd g(3 * n, 3);
-  Eigen::VectorXd h(3 * n);
+  Eigen::Matrix3d gtg = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d gth = Eigen::Vector3d::Zero();
   const double c = std::cos(yaw), s = std::sin(yaw);
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d& t = txs[i].tx_map_m;
@@ -151,13 +183,13 @@ std::optional<Eigen::Vector2d> uhl_direct_position(const std::vector<TxDistances
       const Eigen::Vector2d r = receiver_base(l, o.receiver_radius_m);
       const double gx = r.x() * c - r.y() * s, gy = r.x() * s + r.y() * c;
       const double d = txs[i].distances_m(l);
-      g.row(3 * i + l) << t.x() - gx, t.y() - gy, -0.5;
-      h(3 * i + l) = 0.5 * (-d * d + (t.x() - gx) * (t.x() - gx) + (t.y() - gy) * (t.y() - gy) + z * z);
+      const Eigen::Vector3d row(t.x() - gx, t.y() - gy, -0.5);
+      gtg += row * row.transpose();
+      gth += row * (0.5 * (-d * d + (t.x() - gx) * (t.x() - gx) + (t.y() - gy) * (t.y() - gy) + z * z));
     }
   }
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(g);
-  if (qr.rank() < 3) return std::nullopt;
-  const Eigen::Vector3d theta = qr.solve(h);
+  if (!well_conditioned(gtg)) return std::nullopt;
+  const Eigen::Vector3d theta = gtg.ldlt().solve(gth);
   return Eigen::Vector2d(theta.x(), theta.y());
 }
 
@@ -179,17 +211,18 @@ std::optional<Eigen::Vector2d> uhl_indirect_position(const std::vector<TxDistanc
   if (!collinear) {
     // Multilateration: differences of the circle equations against Tx 0, least squares.
     if (n < 3) return std::nullopt;
-    Eigen::MatrixXd m(n - 1, 2);
-    Eigen::VectorXd v(n - 1);
+    // Normal equations M^T M p = M^T v (2 x 2), checked for rank.
+    Eigen::Matrix2d mtm = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d mtv = Eigen::Vector2d::Zero();
     const Eigen::Vector2d p0 = txs[0].tx_map_m.head<2>();
     for (int i = 1; i < n; ++i) {
       const Eigen::Vector2d pi = txs[i].tx_map_m.head<2>();
-      m.row(i - 1) = 2.0 * (pi - p0).transpose();
-      v(i - 1) = r[0] * r[0] - r[i] * r[i] + pi.squaredNorm() - p0.squaredNorm();
+      const Eigen::Vector2d row = 2.0 * (pi - p0);
+      mtm += row * row.transpose();
+      mtv += row * (r[0] * r[0] - r[i] * r[i] + pi.squaredNorm() - p0.squaredNorm());
     }
-    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(m);
-    if (qr.rank() < 2) return std::nullopt;
-    return Eigen::Vector2d(qr.solve(v));
+    if (!well_conditioned(mtm)) return std::nullopt;
+    return Eigen::Vector2d(mtm.ldlt().solve(mtv));
   }
   // Collinear Txs (eq. 12-13): intersections of every pair of circles, split by the side of the
   // Tx line, averaged per side; the side closer to the DM position wins.
@@ -266,6 +299,74 @@ UhlSolution solve_uhl(const std::vector<TxDistances>& txs, const UhlOptions& o) 
     out.method = UhlMethod::kIndirect;
   }
   return out;
+}
+
+std::optional<UhlJacobian> uhl_jacobian(const std::vector<TxDistances>& txs, const UhlSolution& solution,
+                                        const UhlOptions& o) {
+  if (!solution.ok || solution.method != UhlMethod::kIndirect || solution.collinear) return std::nullopt;
+  const int n = static_cast<int>(txs.size());
+  UhlJacobian j = UhlJacobian::Zero(3, 3 * n);
+
+  // Heading: the DM's phi solves eq. 7, E(phi, A^T b) = 0 (A does not depend on the distances),
+  // so d phi / d q = -(dE / d(A^T b)) (d(A^T b) / d q) / (dE / d phi), with dE / d(A^T b) =
+  // [sin phi, -cos phi] from A^T b = -[b1, b2].
+  // d(A^T b) / d d^a = S_a db/dd(d^a), S_a = sum over the pairs (a, b > a) of A^{a,b}^T minus
+  // that over the pairs (b < a, a) (eq_four_gradient).
+  Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d atb = Eigen::Vector2d::Zero();
+  std::vector<Eigen::Matrix2d> s_of(n, Eigen::Matrix2d::Zero());
+  for (int a = 0; a < n; ++a) {
+    for (int b = a + 1; b < n; ++b) {
+      const EqFourRows rows = eq_four_rows(txs[a], txs[b], o.receiver_radius_m);
+      ata += rows.a.transpose() * rows.a;
+      atb += rows.a.transpose() * rows.b;
+      s_of[a] += rows.a.transpose();
+      s_of[b] -= rows.a.transpose();
+    }
+  }
+  const double phi = solution.pose.z();
+  const Eq7 eq7 = eq7_of(ata, atb);
+  const double slope = eq7.derivative(phi);
+  if (!(std::abs(slope) > 1e-12 * eq7.scale())) return std::nullopt;
+  const Eigen::RowVector2d de_datb(std::sin(phi), -std::cos(phi));
+  for (int a = 0; a < n; ++a) {
+    j.block<1, 3>(2, 3 * a) =
+        -(de_datb * s_of[a] * eq_four_gradient(txs[a].distances_m, o.receiver_radius_m)) / slope;
+  }
+
+  // Position: the IMR multilateration p = (M^T M)^-1 M^T v, M fixed by the Tx positions and
+  // v_i = r_0^2 - r_i^2 + const with r_i^2 = |d^i|^2 / 3 - r_R^2 - z_i^2 (eq. 11).
+  Eigen::Matrix2d mtm = Eigen::Matrix2d::Zero();
+  Eigen::Matrix<double, 2, Eigen::Dynamic> dmtv_dq = Eigen::Matrix<double, 2, Eigen::Dynamic>::Zero(2, 3 * n);
+  const Eigen::Vector2d p0 = txs[0].tx_map_m.head<2>();
+  for (int i = 1; i < n; ++i) {
+    const Eigen::Vector2d row = 2.0 * (txs[i].tx_map_m.head<2>() - p0);
+    mtm += row * row.transpose();
+    dmtv_dq.middleCols<3>(0) += row * (2.0 / 3.0) * txs[0].distances_m.transpose();
+    dmtv_dq.middleCols<3>(3 * i) -= row * (2.0 / 3.0) * txs[i].distances_m.transpose();
+  }
+  if (!well_conditioned(mtm)) return std::nullopt;
+  j.topRows<2>() = mtm.ldlt().solve(dmtv_dq);
+  return j;
+}
+
+UhlJacobian uhl_jacobian_numeric(const std::vector<TxDistances>& txs, const UhlOptions& options) {
+  const double h = 1e-4;  // m: well above rounding, well below the distances' noise
+  UhlJacobian j = UhlJacobian::Zero(3, 3 * static_cast<Eigen::Index>(txs.size()));
+  for (std::size_t i = 0; i < txs.size(); ++i) {
+    for (int l = 0; l < 3; ++l) {
+      auto hi = txs, lo = txs;
+      hi[i].distances_m(l) += h;
+      lo[i].distances_m(l) -= h;
+      const UhlSolution a = solve_uhl(hi, options), b = solve_uhl(lo, options);
+      if (a.ok && b.ok)
+        j.col(3 * static_cast<Eigen::Index>(i) + l) =
+            Eigen::Vector3d(a.pose.x() - b.pose.x(), a.pose.y() - b.pose.y(),
+                            wrap_angle_rad(a.pose.z() - b.pose.z())) /
+            (2 * h);
+    }
+  }
+  return j;
 }
 
 }  // namespace beaconloc::duhl

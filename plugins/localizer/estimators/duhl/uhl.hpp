@@ -59,4 +59,13 @@ std::optional<Eigen::Vector2d> uhl_indirect_position(const std::vector<TxDistanc
 // Table I.
 UhlSolution solve_uhl(const std::vector<TxDistances>& txs, const UhlOptions& options = {});
 
+// d pose / d [d^1; d^2; ...] (3 x 3N) of a solution, analytic, where the pose is the DM heading
+// (eq. 4-9) and the IMR multilateration (eq. 11) on non-collinear Txs; nullopt on the other
+// branches of Table I (collinear Txs), whose Jacobian is left to numeric differentiation.
+using UhlJacobian = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+std::optional<UhlJacobian> uhl_jacobian(const std::vector<TxDistances>& txs, const UhlSolution& solution,
+                                        const UhlOptions& options = {});
+// The same by central differences of solve_uhl, for every branch (6N solves).
+UhlJacobian uhl_jacobian_numeric(const std::vector<TxDistances>& txs, const UhlOptions& options = {});
+
 }  // namespace beaconloc::duhl
