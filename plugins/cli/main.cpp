@@ -88,6 +88,14 @@ void add_localizer_options(CLI::App* app, LocalizerSettings& o, bool standalone)
   app->add_option("--estimator", o.estimator, "estimator plugin (see beaconloc localizer --list-estimators)");
   app->add_option("--receivers", o.receivers, "receivers in the robot frame, x:y[,x:y...] (m)");
   app->add_option("--param", o.parameters, "estimator parameter NAME=VALUE (repeatable)");
+  app->add_option("--map", o.map_file,
+                  "occupancy grid for laser models, ROS map_server YAML + PGM (default in run and demo: the "
+                  "scenario's map)")
+      ->check(CLI::ExistingFile);
+  app->add_option("--initial-pose", o.initial_pose,
+                  "X Y YAW: where the robot starts, for estimators placed by hand (default in run and demo: "
+                  "the scenario's start)")
+      ->expected(3);
   if (!standalone) return;
   app->add_option("--robot", o.robot, "serve only this robot id (default: every robot)");
   app->add_option("--receiver-radius-m", o.receiver_radius_m,
@@ -179,6 +187,7 @@ int run(int argc, char** argv) {
   std::uint64_t accuracy_first_seed = 1;
   double accuracy_settle_s = 0.0;
   std::optional<double> accuracy_odometry_k_v_m;
+  std::string accuracy_table = "pose";
   std::string accuracy_out;
   auto* accuracy = app.add_subcommand(
       "accuracy",
@@ -196,6 +205,11 @@ int run(int argc, char** argv) {
       ->add_option("--odometry-k-v-m", accuracy_odometry_k_v_m,
                    "replace the scenarios' odometry noise k_v (sigma_v^2 = k_v |v| / dT per wheel)")
       ->check(kNonNegative);
+  accuracy
+      ->add_option("--table", accuracy_table,
+                   "pose: E_p, E_phi, E_S, NEES (seed 000 Table II); distance: mean, std, RMSE, max of the "
+                   "position error and the association rates (seed 001 Tables 4-7)")
+      ->check(CLI::IsMember({"pose", "distance"}));
   accuracy->add_option("--out", accuracy_out, "also write the table to this file");
 
   auto* monitor = app.add_subcommand(
@@ -253,15 +267,17 @@ int run(int argc, char** argv) {
         for (const auto& estimator : accuracy_estimators) {
           AccuracyRow row{scenario.name, estimator, {}};
           for (int k = 0; k < accuracy_seeds; ++k) {
-            row.runs.push_back(run_scenario_offline(scenario,
-                                                    accuracy_first_seed + static_cast<std::uint64_t>(k),
-                                                    estimator, accuracy_parameters, accuracy_settle_s)
-                                   .metrics);
+            const OfflineRunResult r =
+                run_scenario_offline(scenario, accuracy_first_seed + static_cast<std::uint64_t>(k), estimator,
+                                     accuracy_parameters, accuracy_settle_s);
+            row.runs.push_back(r.metrics);
+            if (r.associations.total()) row.associations.push_back(r.associations);
           }
           rows.push_back(row);
         }
       }
-      const std::string table = accuracy_table_markdown(rows);
+      const std::string table =
+          accuracy_table == "distance" ? distance_table_markdown(rows) : accuracy_table_markdown(rows);
       std::cout << table;
       if (!accuracy_out.empty()) {
         std::ofstream out(accuracy_out);
@@ -319,6 +335,14 @@ int run(int argc, char** argv) {
           o.gateway.speed = processes ? 10.0 : 0.0;  // 0: as fast as it goes
         if (run_cmd->count("--duration-s") == 0 && source.scenario)
           o.gateway.duration_s = source.scenario->duration_s;
+        // A scenario states its beacon system's range limits and noise; the decoder takes them
+        // unless told otherwise (its defaults are seed 000's: seed 001's ranges reach 14 m).
+        if (source.scenario) {
+          if (run_cmd->count("--min-range-m") == 0) o.decoder.min_range_m = source.scenario->min_range_m;
+          if (run_cmd->count("--max-range-m") == 0) o.decoder.max_range_m = source.scenario->max_range_m;
+          if (run_cmd->count("--range-sigma-m") == 0)
+            o.decoder.range_sigma_m = source.scenario->range_sigma_m;
+        }
         o.print_progress = true;
       }
       if (!out_dir.empty() && o.gateway.truth_csv.empty() && !processes)

@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "beaconloc/core/occupancy_grid_io.hpp"
 #include "beaconloc/dds/stop_signal.hpp"
 #include "decoder_participant.hpp"
 #include "diagnostics_recorder.hpp"
@@ -27,6 +28,10 @@
 extern char** environ;
 
 namespace beaconloc::cli {
+
+LocalizerSettings with_scenario_defaults(LocalizerSettings s, const LoadedSource& source,
+                                         const std::string& out_dir);
+
 namespace {
 
 using namespace std::chrono_literals;
@@ -147,7 +152,11 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
   std::mutex truth_mutex;
   TruthTrack truth;
   const BeaconMap beacons = source.source->beacon_map();
-  const EstimatorConfig config = o.localizer.config(source.source->receivers());
+  const LocalizerSettings settings = with_scenario_defaults(o.localizer, source, o.out_dir);
+  EstimatorConfig config = settings.config(source.source->receivers());
+  if (!config.occupancy_grid && source.scenario && source.scenario->map) {  // no --out: no map file
+    config.occupancy_grid = std::make_shared<const OccupancyGrid>(*source.scenario->map);
+  }
   LocalizerParticipant localizer(o.dds, LocalizerCore(o.localizer.estimator, config, o.localizer.robot));
   DecoderParticipant decoder(o.dds, o.decoder);
   PoseRecorder recorder(o.dds);
@@ -250,7 +259,9 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
 
   auto localizer_args = std::vector<std::string>{"localizer"};
   for (const auto& a : dds_arguments(o.dds)) localizer_args.push_back(a);
-  for (const auto& a : o.localizer.arguments(receivers)) localizer_args.push_back(a);
+  for (const auto& a : with_scenario_defaults(o.localizer, source, o.out_dir).arguments(receivers)) {
+    localizer_args.push_back(a);
+  }
   auto decoder_args = std::vector<std::string>{"decoder"};
   for (const auto& a : dds_arguments(o.dds)) decoder_args.push_back(a);
   for (const auto& a : std::vector<std::string>{
@@ -375,7 +386,29 @@ EstimatorConfig LocalizerSettings::config(const std::optional<ReceiverArray>& fa
     c.receivers.receiver_height_m = receiver_height_m;
   }
   c.parameters = parse_estimator_parameters(parameters, "--param");
+  if (!map_file.empty())
+    c.occupancy_grid = std::make_shared<const OccupancyGrid>(load_occupancy_grid(map_file));
+  if (!initial_pose.empty()) {
+    if (initial_pose.size() != 3) throw std::invalid_argument("--initial-pose takes X Y YAW");
+    c.initial_pose = Pose2(initial_pose[0], initial_pose[1], initial_pose[2]);
+  }
   return c;
+}
+
+// What a simulated source tells a localizer that was not told otherwise: the scenario's map,
+// written as a map file in out_dir, and its start pose (the robot placed by hand).
+LocalizerSettings with_scenario_defaults(LocalizerSettings s, const LoadedSource& source,
+                                         const std::string& out_dir) {
+  if (!source.scenario) return s;
+  if (s.map_file.empty() && source.scenario->map && !out_dir.empty()) {
+    s.map_file = out_dir + "/map.yaml";
+    write_occupancy_grid(*source.scenario->map, s.map_file);
+  }
+  if (s.initial_pose.empty()) {
+    const Pose2 start = source.scenario->trajectory.pose_at(0.0);
+    s.initial_pose = {start.x(), start.y(), start.z()};
+  }
+  return s;
 }
 
 std::vector<std::string> LocalizerSettings::arguments(const std::optional<ReceiverArray>& fallback) const {
@@ -390,6 +423,14 @@ std::vector<std::string> LocalizerSettings::arguments(const std::optional<Receiv
   for (const auto& p : parameters) {
     a.push_back("--param");
     a.push_back(p);
+  }
+  if (!map_file.empty()) {
+    a.push_back("--map");
+    a.push_back(map_file);
+  }
+  if (!initial_pose.empty()) {
+    a.push_back("--initial-pose");
+    for (double v : initial_pose) a.push_back(number(v));
   }
   return a;
 }

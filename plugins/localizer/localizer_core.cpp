@@ -8,8 +8,8 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
     : estimator_name_(std::move(estimator_name)),
       config_(std::move(config)),
       robot_filter_(std::move(robot_filter)) {
-  // Fail at start, not at the first sample, when the name is wrong.
-  EstimatorRegistry::instance().create(estimator_name_, config_);
+  // Fail at start, not at the first sample, when the name or the configuration is wrong.
+  uses_laser_ = EstimatorRegistry::instance().create(estimator_name_, config_)->uses_laser();
 }
 
 void LocalizerCore::set_beacon_map(const BeaconMap& map) {
@@ -63,6 +63,24 @@ void LocalizerCore::on_range(const std::string& robot_id, const RangeMeasurement
   }
   counts_.accept();
   r->beacons_used.insert(range.beacon_id);
+}
+
+void LocalizerCore::on_laser(const std::string& robot_id, const LaserScanSample& scan) {
+  if (!uses_laser_) return;  // the participant does not subscribe to scans then; nothing to count
+  Robot* r = robot(robot_id, "laser");
+  if (!r) return;
+  const InputResult result = r->estimator->update_laser(scan);
+  if (!result.accepted) {
+    counts_.reject("laser." + result.rejection);
+    return;
+  }
+  counts_.accept();
+}
+
+std::vector<Estimator::Association> LocalizerCore::take_associations(const std::string& robot_id) {
+  auto it = robots_.find(robot_id);
+  return it == robots_.end() ? std::vector<Estimator::Association>{}
+                             : it->second.estimator->take_associations();
 }
 
 PoseStatus LocalizerCore::worst_status() const {

@@ -31,6 +31,11 @@ class LocalizerCore {
   // Predicts; returns the pose to publish once the robot's estimator has one.
   std::optional<LocalizerOutput> on_odometry(const std::string& robot_id, const OdometrySample& odometry);
   void on_range(const std::string& robot_id, const RangeMeasurement& range);
+  // Laser scans reach estimators that use them (uses_laser()); others never see one.
+  bool uses_laser() const { return uses_laser_; }
+  void on_laser(const std::string& robot_id, const LaserScanSample& scan);
+  // The robot's estimator's associations of anonymous ranges since last asked (evaluation).
+  std::vector<Estimator::Association> take_associations(const std::string& robot_id);
 
   const std::string& estimator_name() const { return estimator_name_; }
   const RejectionCounter& counts() const { return counts_; }  // reasons prefixed odometry./range.
@@ -48,6 +53,7 @@ class LocalizerCore {
   std::string estimator_name_;
   EstimatorConfig config_;
   std::string robot_filter_;
+  bool uses_laser_ = false;
   BeaconMap map_;
   std::map<std::string, Robot> robots_;
   RejectionCounter counts_;

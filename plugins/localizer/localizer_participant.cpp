@@ -27,6 +27,12 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       &deadline_misses_);
   participant_.subscribe<msg::OdometryPubSubType>(
       dds::kOdometryTopic, [this](const msg::Odometry& m) { on_odometry(m); }, &deadline_misses_);
+  if (core_.uses_laser()) {
+    participant_.subscribe<msg::LaserScanPubSubType>(dds::kLaserScanTopic, [this](const msg::LaserScan& m) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      core_.on_laser(m.robot_id(), dds::from_msg(m));
+    });
+  }
   diagnostics_ =
       std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] { return diagnostics_snapshot(); });
 }

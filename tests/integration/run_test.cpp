@@ -114,6 +114,24 @@ TEST_F(Run, OneProcessPerParticipant) {
   EXPECT_TRUE(std::filesystem::exists(dir_ + "/localizer.log"));
 }
 
+// Seed 001 through DDS, one process per participant: laser scans and anonymous beacon ranges
+// reach the UKF over the topics, the map as a map_server file named on the localizer's command
+// line (written from the scenario), the start pose as the paper's hand placement.
+TEST_F(Run, UkfFusesLaserAndAnonymousBeaconsAcrossProcesses) {
+  const auto [code, out] = beaconloc({"run", "--processes", "--speed", "4", "--duration-s", "20",
+                                      "--scenario", kSource + "/examples/scenarios/seed001_classroom.yaml",
+                                      "--estimator", "ukf_lrf", "--out", dir_});
+  ASSERT_EQ(code, 0) << out;
+  const std::string metrics = read(dir_ + "/metrics.json");
+  EXPECT_GT(json_number(metrics, "samples"), 700);           // 20 s of 22 ms odometry steps: ~900
+  EXPECT_LT(json_number(metrics, "position_rms_m"), 0.101);  // the paper's Table 6, fusion
+  EXPECT_TRUE(std::filesystem::exists(dir_ + "/map.yaml"));
+  EXPECT_TRUE(std::filesystem::exists(dir_ + "/map.pgm"));
+  // Every beacon range decoded (the scenario's 15 m limit reached the decoder), none refused.
+  EXPECT_NE(out.find("beaconloc.decoder: ok, accepted"), std::string::npos) << out;
+  EXPECT_EQ(out.find("out_of_range_tof"), std::string::npos) << out;
+}
+
 TEST_F(Run, ScenarioErrorsAreReportedWithTheFile) {
   std::ofstream(dir_ + "/bad.yaml") << "name: x\nbeacons: [{id: 1, position_m: [0, 0]}]\n";
   const auto [code, out] = beaconloc({"run", "--scenario", dir_ + "/bad.yaml", "--out", dir_ + "/o"});

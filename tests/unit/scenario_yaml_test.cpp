@@ -71,6 +71,21 @@ TEST(ScenarioYaml, MinimalFileUsesTheDocumentedDefaults) {
   EXPECT_NEAR(s.trajectory.period_s(), 2.0, 1e-12);
 }
 
+TEST(ScenarioYaml, UnmappedObstaclesAreInTheWorldTheLaserSeesNotInTheMap) {
+  const Scenario s = parse_scenario(std::string(kMinimal) + R"(map:
+  size_m: [4.0, 3.0]
+  obstacles:
+    - {min_m: [1.0, 1.0], max_m: [1.5, 1.5]}
+  unmapped_obstacles:
+    - {min_m: [2.5, 1.0], max_m: [3.0, 1.5]}
+)");
+  ASSERT_TRUE(s.map && s.world);
+  EXPECT_TRUE(s.map->occupied_at({1.25, 1.25}) && s.world->occupied_at({1.25, 1.25}));
+  EXPECT_FALSE(s.map->occupied_at({2.75, 1.25}));
+  EXPECT_TRUE(s.world->occupied_at({2.75, 1.25}));
+  EXPECT_FALSE(parse_scenario(kMinimal + std::string("map:\n  size_m: [4.0, 3.0]\n")).world);
+}
+
 TEST(ScenarioYaml, ErrorsNameTheKeyAndLine) {
   EXPECT_EQ(error_of(std::string(kMinimal) + "colour: red\n"), "test.yaml:9: 'colour' is not a known key");
   EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {range_sigma_m: -1}\n")

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -15,7 +16,18 @@ EstimatorConfig config_for(const sim::Scenario& scenario, const std::map<std::st
   EstimatorConfig config;
   config.receivers = scenario.receivers;
   config.parameters = parameters;
+  if (scenario.map) config.occupancy_grid = std::make_shared<const OccupancyGrid>(*scenario.map);
+  config.initial_pose = scenario.trajectory.pose_at(0.0);  // placed by hand, as in seed 001
   return config;
+}
+
+// The scenario's range limits and noise (what `beaconloc run --scenario` gives its decoder).
+TofDecoderConfig decoder_config_for(const sim::Scenario& scenario) {
+  TofDecoderConfig c;
+  c.min_range_m = scenario.min_range_m;
+  c.max_range_m = scenario.max_range_m;
+  c.range_sigma_m = scenario.range_sigma_m;
+  return c;
 }
 
 }  // namespace
@@ -29,19 +41,46 @@ std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t s
 
 OfflineStack::OfflineStack(const sim::Scenario& scenario, const std::string& estimator,
                            const std::map<std::string, double>& parameters)
-    : localizer(estimator, config_for(scenario, parameters)) {
+    : localizer(estimator, config_for(scenario, parameters)), decoder(decoder_config_for(scenario)) {
   localizer.set_beacon_map(BeaconMap(scenario.beacons));
   decoder.set_beacon_map(BeaconMap(scenario.beacons));
 }
 
 std::optional<LocalizerOutput> OfflineStack::feed(const std::string& robot_id, const SourceEvent& e) {
   if (e.kind == SourceEvent::Kind::kTof) {
-    if (const auto out = decoder.decode(robot_id, e.tof); out.range)
+    if (const auto out = decoder.decode(robot_id, e.tof); out.range) {
+      if (e.true_beacon_id != kBeaconUnidentified) range_truth_[out.range->range.stamp_ns] = e.true_beacon_id;
       localizer.on_range(robot_id, out.range->range);
+    }
+    return std::nullopt;
+  }
+  if (e.kind == SourceEvent::Kind::kLaserScan) {
+    localizer.on_laser(robot_id, e.scan);
     return std::nullopt;
   }
   if (e.kind != SourceEvent::Kind::kOdometry) return std::nullopt;
-  return localizer.on_odometry(robot_id, e.odometry);
+  auto pose = localizer.on_odometry(robot_id, e.odometry);
+  for (const auto& a : localizer.take_associations(robot_id)) {
+    const auto truth = range_truth_.find(a.range_stamp_ns);
+    if (truth == range_truth_.end()) continue;
+    AssociationTally::Count& c = associations.by_beacon[truth->second];
+    ++c.total;
+    if (a.beacon_id == truth->second) ++c.correct;
+    range_truth_.erase(truth);
+  }
+  return pose;
+}
+
+std::size_t AssociationTally::total() const {
+  std::size_t n = 0;
+  for (const auto& [id, c] : by_beacon) n += c.total;
+  return n;
+}
+
+std::size_t AssociationTally::correct() const {
+  std::size_t n = 0;
+  for (const auto& [id, c] : by_beacon) n += c.correct;
+  return n;
 }
 
 OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64_t seed,
@@ -56,6 +95,7 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
   }
   OfflineRunResult result;
   result.poses = rows.size();
+  result.associations = stack.associations;
   EvaluationOptions options;
   if (!rows.empty()) options.score_from_ns = rows.front().estimate.stamp_ns + s_to_ns(settle_s);
   result.metrics = evaluate(truth, rows, options);
@@ -94,6 +134,52 @@ std::string accuracy_table_markdown(const std::vector<AccuracyRow>& rows) {
     out << "| " << row.scenario << " | " << row.estimator << " | " << row.runs.size() << " | "
         << mean_and_spread(ep, 3) << " | " << mean_and_spread(ephi, 2) << " | " << mean_and_spread(es, 3)
         << " | " << mean_and_spread(nees, 2) << " |\n";
+  }
+  return out.str();
+}
+
+std::string distance_table_markdown(const std::vector<AccuracyRow>& rows) {
+  std::set<std::uint32_t> beacon_ids;
+  for (const auto& row : rows) {
+    for (const auto& tally : row.associations) {
+      for (const auto& [id, c] : tally.by_beacon) beacon_ids.insert(id);
+    }
+  }
+  std::ostringstream out;
+  out << "| scenario | estimator | seeds | mean (m) | std (m) | RMSE (m) | max (m) |";
+  for (auto id : beacon_ids) out << " association B" << id << " |";
+  out << " association, all |\n|---|---|---|---|---|---|---|";
+  for (std::size_t i = 0; i <= beacon_ids.size(); ++i) out << "---|";
+  out << '\n';
+  for (const auto& row : rows) {
+    std::vector<double> mean, sd, rms, max;
+    for (const auto& m : row.runs) {
+      mean.push_back(m.position_mean_m);
+      rms.push_back(m.position_rms_m);
+      max.push_back(m.position_max_m);
+      sd.push_back(std::sqrt(
+          std::max(0.0, m.position_rms_m * m.position_rms_m - m.position_mean_m * m.position_mean_m)));
+    }
+    out << "| " << row.scenario << " | " << row.estimator << " | " << row.runs.size() << " | "
+        << mean_and_spread(mean, 4) << " | " << mean_and_spread(sd, 4) << " | " << mean_and_spread(rms, 4)
+        << " | " << mean_and_spread(max, 4) << " |";
+    auto rate = [&](std::optional<std::uint32_t> id) {
+      std::vector<double> rates;
+      for (const auto& tally : row.associations) {
+        std::size_t total = 0, correct = 0;
+        if (id) {
+          const auto it = tally.by_beacon.find(*id);
+          if (it != tally.by_beacon.end()) total = it->second.total, correct = it->second.correct;
+        } else {
+          total = tally.total();
+          correct = tally.correct();
+        }
+        if (total) rates.push_back(100.0 * static_cast<double>(correct) / static_cast<double>(total));
+      }
+      return rates.empty() ? std::string("n/a") : mean_and_spread(rates, 1) + " %";
+    };
+    for (auto id : beacon_ids) out << ' ' << rate(id) << " |";
+    out << ' ' << rate(std::nullopt) << " |\n";
   }
   return out.str();
 }

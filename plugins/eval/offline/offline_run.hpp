@@ -19,8 +19,20 @@ namespace beaconloc {
 // Every event of a scenario up to duration_s, in stamp order.
 std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed, double duration_s);
 
-// Decoder and localizer cores wired as the participants wire them, knowing the scenario's map
-// and receivers.
+// Anonymous ranges associated with a beacon by the estimator, scored against the simulator's
+// truth (who fired), per true beacon.
+struct AssociationTally {
+  struct Count {
+    std::size_t total = 0;
+    std::size_t correct = 0;
+  };
+  std::map<std::uint32_t, Count> by_beacon;
+  std::size_t total() const;
+  std::size_t correct() const;
+};
+
+// Decoder and localizer cores wired as the participants wire them, knowing the scenario's map,
+// receivers, occupancy grid, start pose and range limits.
 struct OfflineStack {
   explicit OfflineStack(const sim::Scenario& scenario, const std::string& estimator = "range_ekf",
                         const std::map<std::string, double>& parameters = {});
@@ -29,11 +41,16 @@ struct OfflineStack {
 
   LocalizerCore localizer;
   TofDecoder decoder;
+  AssociationTally associations;
+
+ private:
+  std::map<StampNs, std::uint32_t> range_truth_;  // range stamp -> the beacon that fired
 };
 
 struct OfflineRunResult {
   Metrics metrics;
   std::size_t poses = 0;
+  AssociationTally associations;
 };
 
 // Scores poses from settle_s after the first one (the first global fix is not tracking).
@@ -45,11 +62,16 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
 struct AccuracyRow {
   std::string scenario;
   std::string estimator;
-  std::vector<Metrics> runs;  // one per seed
+  std::vector<Metrics> runs;                   // one per seed
+  std::vector<AssociationTally> associations;  // one per seed, where the ranges are anonymous
 };
 
 // A markdown table: mean and standard deviation over the seeds of E_p RMS, E_phi RMS, E_S mean
 // and the NEES-in-band fraction, one row per scenario and estimator.
 std::string accuracy_table_markdown(const std::vector<AccuracyRow>& rows);
+
+// Seed 001 Tables 4-7: mean, standard deviation, RMS and maximum of the distance error, and the
+// rate of correct association per beacon and overall, each as mean +- spread over the seeds.
+std::string distance_table_markdown(const std::vector<AccuracyRow>& rows);
 
 }  // namespace beaconloc

@@ -67,6 +67,8 @@ struct Scenario {
 
   Trajectory trajectory;
   std::optional<OccupancyGrid> map;
+  // The world the laser sees when it differs from the map (unmapped obstacles); none: the map.
+  std::optional<OccupancyGrid> world;
   std::optional<LaserModel> laser;
 };
 

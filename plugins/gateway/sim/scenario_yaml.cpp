@@ -244,7 +244,8 @@ void read_trajectory(const Section& root, Scenario& sc) {
 
 void read_map_and_laser(const Section& root, Scenario& sc) {
   if (root.has("map")) {
-    const Section m = root.child("map", {"resolution_m", "origin_m", "size_m", "border", "obstacles"});
+    const Section m = root.child(
+        "map", {"resolution_m", "origin_m", "size_m", "border", "obstacles", "unmapped_obstacles"});
     const double res = m.number("resolution_m", 0.1, 0.005, 10.0);
     if (!m.has("size_m")) m.fail(m.join("size_m"), "is required", root.node("map"));
     const Eigen::Vector2d size = vec2(m, m.node("size_m"), m.join("size_m"));
@@ -255,17 +256,25 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
     OccupancyGrid grid(origin, res, static_cast<int>(std::ceil(size.x() / res - 1e-9)),
                        static_cast<int>(std::ceil(size.y() / res - 1e-9)));
     if (m.get<bool>("border", true)) grid.fill_border();
-    const YAML::Node obstacles = m.node("obstacles");
-    for (std::size_t i = 0; obstacles && obstacles.IsSequence() && i < obstacles.size(); ++i) {
-      const Section o(obstacles[i], m.join("obstacles") + "[" + std::to_string(i) + "]", root.origin(),
-                      {"min_m", "max_m"});
-      if (!o.has("min_m") || !o.has("max_m")) o.fail(o.join("min_m"), "and max_m are required", obstacles[i]);
-      const Eigen::Vector2d lo = vec2(o, o.node("min_m"), o.join("min_m")),
-                            hi = vec2(o, o.node("max_m"), o.join("max_m"));
-      if ((hi.array() <= lo.array()).any()) o.fail(o.join("max_m"), "must exceed min_m", obstacles[i]);
-      grid.fill_rectangle(lo, hi);
-    }
+    auto fill = [&](const char* key, OccupancyGrid& target) {
+      const YAML::Node list = m.node(key);
+      for (std::size_t i = 0; list && list.IsSequence() && i < list.size(); ++i) {
+        const Section o(list[i], m.join(key) + "[" + std::to_string(i) + "]", root.origin(),
+                        {"min_m", "max_m"});
+        if (!o.has("min_m") || !o.has("max_m")) o.fail(o.join("min_m"), "and max_m are required", list[i]);
+        const Eigen::Vector2d lo = vec2(o, o.node("min_m"), o.join("min_m")),
+                              hi = vec2(o, o.node("max_m"), o.join("max_m"));
+        if ((hi.array() <= lo.array()).any()) o.fail(o.join("max_m"), "must exceed min_m", list[i]);
+        target.fill_rectangle(lo, hi);
+      }
+    };
+    fill("obstacles", grid);
     sc.map = grid;
+    if (m.has("unmapped_obstacles")) {  // in the world the laser sees, not in the map
+      OccupancyGrid world = grid;
+      fill("unmapped_obstacles", world);
+      sc.world = world;
+    }
   }
   if (root.has("laser")) {
     if (!sc.map) root.fail("laser", "needs a map to cast its rays on", root.node("laser"));

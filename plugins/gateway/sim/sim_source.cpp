@@ -138,7 +138,8 @@ SourceEvent SimSource::scan_at(StampNs stamp_ns) {
   e.scan.range_max_m = static_cast<float>(laser.max_range_m);
   for (int i = 0; i < laser.beams; ++i) {
     const double angle = sensor.z() - laser.fov_rad / 2.0 + i * increment;
-    const auto hit = scenario_.map->cast_ray(sensor.head<2>(), angle, laser.max_range_m);
+    const OccupancyGrid& world = scenario_.world ? *scenario_.world : *scenario_.map;
+    const auto hit = world.cast_ray(sensor.head<2>(), angle, laser.max_range_m);
     const double noise = normal();  // drawn for every beam: the stream does not depend on hits
     e.scan.ranges_m.push_back(hit ? static_cast<float>(std::max(0.0, *hit + laser.range_sigma_m * noise))
                                   : std::numeric_limits<float>::infinity());

@@ -53,7 +53,13 @@ bool OccupancyGrid::occupied_at(const Eigen::Vector2d& p_m) const {
 
 std::optional<double> OccupancyGrid::cast_ray(const Eigen::Vector2d& from_m, double angle_rad,
                                               double max_range_m) const {
-  const double dx = std::cos(angle_rad), dy = std::sin(angle_rad);
+  return cast_ray_along(from_m, {std::cos(angle_rad), std::sin(angle_rad)}, max_range_m);
+}
+
+std::optional<double> OccupancyGrid::cast_ray_along(const Eigen::Vector2d& from_m,
+                                                    const Eigen::Vector2d& direction,
+                                                    double max_range_m) const {
+  const double dx = direction.x(), dy = direction.y();
   const Eigen::Vector2d g = (from_m - origin_m_) / resolution_m_;  // position in cell units
   int ix = static_cast<int>(std::floor(g.x())), iy = static_cast<int>(std::floor(g.y()));
   if (occupied(ix, iy)) return 0.0;

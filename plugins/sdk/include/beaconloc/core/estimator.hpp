@@ -4,12 +4,14 @@
 // DDS header, so the same code runs live, in replay and in tests.
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "beaconloc/core/beacon_map.hpp"
 #include "beaconloc/core/measurements.hpp"
+#include "beaconloc/core/occupancy_grid.hpp"
 #include "beaconloc/core/pose2.hpp"
 #include "beaconloc/core/receiver_array.hpp"
 
@@ -36,6 +38,10 @@ struct InputResult {
 struct EstimatorConfig {
   ReceiverArray receivers;
   std::map<std::string, double> parameters;  // estimator-specific, documented by each plugin
+  // The occupancy grid of the map, for estimators with a laser model; null when none was given.
+  std::shared_ptr<const OccupancyGrid> occupancy_grid;
+  // Where the robot starts, for estimators placed by hand (seed 001 Sec. 4.1); others ignore it.
+  std::optional<Pose2> initial_pose;
 
   double parameter(const std::string& name, double fallback) const {
     auto it = parameters.find(name);
@@ -55,6 +61,19 @@ class Estimator {
   virtual void set_beacon_map(const BeaconMap& map) = 0;
   virtual InputResult predict(const OdometrySample& odometry) = 0;
   virtual InputResult update(const RangeMeasurement& range) = 0;
+  // Laser scans, for the estimators that use them (uses_laser()); the others are never pushed one.
+  virtual bool uses_laser() const { return false; }
+  virtual InputResult update_laser(const LaserScanSample& /*scan*/) {
+    return InputResult::rejected("laser_unused");
+  }
+  // Anonymous ranges the estimator associated with a beacon since last asked (for evaluation
+  // against the simulator's truth); empty for estimators that need identified ranges.
+  struct Association {
+    StampNs range_stamp_ns;
+    std::uint32_t receiver_id;
+    std::uint32_t beacon_id;
+  };
+  virtual std::vector<Association> take_associations() { return {}; }
   // The current pose; nullopt until the estimator has one.
   virtual std::optional<PoseEstimate> estimate() const = 0;
   // Status from data time alone (the stamps pushed so far).

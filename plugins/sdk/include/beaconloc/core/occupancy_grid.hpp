@@ -32,6 +32,9 @@ class OccupancyGrid {
   // occupied cell; nullopt when none lies within max_range_m (cells outside the grid are free).
   // A start inside an occupied cell gives 0.
   std::optional<double> cast_ray(const Eigen::Vector2d& from_m, double angle_rad, double max_range_m) const;
+  // The same along a unit direction [cos, sin] (callers casting many rays rotate them once).
+  std::optional<double> cast_ray_along(const Eigen::Vector2d& from_m, const Eigen::Vector2d& unit_direction,
+                                       double max_range_m) const;
 
  private:
   std::size_t index(int ix, int iy) const { return static_cast<std::size_t>(iy) * width_ + ix; }

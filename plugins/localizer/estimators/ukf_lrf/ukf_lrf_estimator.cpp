@@ -1,0 +1,287 @@
+#include "ukf_lrf_estimator.hpp"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <stdexcept>
+
+#include "beaconloc/core/estimator_registry.hpp"
+#include "beaconloc/core/models/range_model.hpp"
+#include "beaconloc/core/models/velocity_motion.hpp"
+
+namespace beaconloc::ukf_lrf {
+namespace {
+
+constexpr int kPose = 3;
+constexpr int kMotionNoise = 2;  // eq. 8: n_u on (v, omega)
+
+bool usable_beam(float range_m, const LaserScanSample& scan) {
+  return std::isfinite(range_m) && range_m > scan.range_min_m && range_m < scan.range_max_m;
+}
+
+}  // namespace
+
+UkfLrfParameters UkfLrfParameters::from(const EstimatorConfig& c) {
+  UkfLrfParameters p;
+  p.unscented.alpha = c.parameter("ut_alpha", p.unscented.alpha);
+  p.unscented.beta = c.parameter("ut_beta", p.unscented.beta);
+  p.unscented.kappa = c.parameter("ut_kappa", p.unscented.kappa);
+  for (int i = 0; i < 4; ++i) p.alpha[i] = c.parameter("alpha" + std::to_string(i + 1), p.alpha[i]);
+  p.beacon_sigma_m = c.parameter("beacon_sigma_m", p.beacon_sigma_m);
+  p.laser_sigma_m = c.parameter("laser_sigma_m", p.laser_sigma_m);
+  p.initial_pose = c.initial_pose;
+  p.initial_sigma_xy_m = c.parameter("initial_sigma_xy_m", p.initial_sigma_xy_m);
+  p.initial_sigma_yaw_rad = c.parameter("initial_sigma_yaw_rad", p.initial_sigma_yaw_rad);
+  p.laser_mount_base = Pose2(c.parameter("laser_mount_x_m", 0.0), c.parameter("laser_mount_y_m", 0.0),
+                             c.parameter("laser_mount_yaw_rad", 0.0));
+  p.max_odometry_gap_s = c.parameter("max_odometry_gap_s", p.max_odometry_gap_s);
+  if (!(p.beacon_sigma_m > 0.0 && p.laser_sigma_m > 0.0)) {
+    throw std::invalid_argument("ukf_lrf: beacon_sigma_m and laser_sigma_m must be positive");
+  }
+  return p;
+}
+
+UkfLrf::UkfLrf(const EstimatorConfig& config, Mode mode)
+    : mode_(mode),
+      params_(UkfLrfParameters::from(config)),
+      grid_(config.occupancy_grid),
+      timeline_(params_.max_odometry_gap_s) {
+  if (mode_ != Mode::kBeaconsOnly && !grid_) {
+    throw std::invalid_argument(name() + " needs the occupancy grid of the map (localizer --map FILE)");
+  }
+  if (mode_ != Mode::kLaserOnly && config.receivers.size() != 1) {
+    throw std::invalid_argument(name() + " takes the ranges of one receiver (seed 001 Sec. 4.1)");
+  }
+  if (mode_ != Mode::kLaserOnly) {
+    receiver_base_m_ = config.receivers.receivers_base_m[0];
+    receiver_height_m_ = config.receivers.receiver_height_m;
+  }
+  if (params_.initial_pose) {
+    mean_ = *params_.initial_pose;
+    covariance_ = Cov3(Eigen::Vector3d(params_.initial_sigma_xy_m * params_.initial_sigma_xy_m,
+                                       params_.initial_sigma_xy_m * params_.initial_sigma_xy_m,
+                                       params_.initial_sigma_yaw_rad * params_.initial_sigma_yaw_rad)
+                           .asDiagonal());
+    initialized_ = true;
+  }
+}
+
+std::string UkfLrf::name() const {
+  switch (mode_) {
+    case Mode::kFusion:
+      return "ukf_lrf";
+    case Mode::kLaserOnly:
+      return "ukf_lrf_laser_only";
+    case Mode::kBeaconsOnly:
+      return "ukf_lrf_beacons_only";
+  }
+  return "ukf_lrf";
+}
+
+InputResult UkfLrf::update(const RangeMeasurement& r) {
+  if (mode_ == Mode::kLaserOnly) return InputResult::rejected("beacons_unused");
+  if (!std::isfinite(r.range_m) || !(r.range_m > 0.0)) return InputResult::rejected("invalid_range");
+  if (r.receiver_id != 0) return InputResult::rejected("unknown_receiver");
+  if (map_.empty()) return InputResult::rejected("no_beacon_map");
+  // Anonymous or not, the range is associated at the next step (Table 2): the id a beacon may
+  // announce is not used, as in the paper (Sec. 4.1). It is fused at that step, not held until
+  // the cycle of four is complete as the paper does: the robot moves 6.6 cm between two slots
+  // (0.42 m/s, 156 ms).
+  if (pending_ranges_.size() >= 64) return InputResult::rejected("ranges_without_odometry");
+  pending_ranges_.push_back(r);
+  return InputResult::ok();
+}
+
+InputResult UkfLrf::update_laser(const LaserScanSample& scan) {
+  if (mode_ == Mode::kBeaconsOnly) return InputResult::rejected("laser_unused");
+  if (scan.ranges_m.empty() || !std::isfinite(scan.angle_min_rad) ||
+      !std::isfinite(scan.angle_increment_rad) || !(scan.range_max_m > scan.range_min_m)) {
+    return InputResult::rejected("malformed_scan");
+  }
+  pending_scan_ = scan;  // a newer scan replaces one not yet used: the filter steps at odometry rate
+  return InputResult::ok();
+}
+
+InputResult UkfLrf::predict(const OdometrySample& o) {
+  const OdometryTimeline::Step t = timeline_.advance(o);
+  if (!t.result.accepted) return t.result;
+  if (!initialized_) {
+    pending_ranges_.clear();
+    pending_scan_.reset();
+    return InputResult::rejected("no_initial_pose");
+  }
+  if (!t.integrate) return InputResult::ok();
+  const double v = (o.wheel_velocity_right_mps + o.wheel_velocity_left_mps) / 2.0;
+  const double omega = (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / o.wheel_base_m;
+  return step(v, omega, t.dt_s);
+}
+
+InputResult UkfLrf::step(double v, double omega, double dt) {
+  // The measurements of this step (Sec. 4.1: whichever arrived; the other's terms dropped).
+  std::vector<double> beam_ranges_m;  // the measured ranges of the usable beams
+  LaserBeams laser;
+  if (pending_scan_) {
+    const LaserScanSample& scan = *pending_scan_;
+    laser.mount_base = params_.laser_mount_base;
+    laser.max_range_m = scan.range_max_m;
+    for (std::size_t i = 0; i < scan.ranges_m.size(); ++i) {
+      if (!usable_beam(scan.ranges_m[i], scan)) continue;
+      beam_ranges_m.push_back(scan.ranges_m[i]);
+      laser.add_beam(scan.angle_min_rad + static_cast<double>(i) * scan.angle_increment_rad);
+    }
+  }
+  const std::vector<RangeMeasurement> ranges = std::move(pending_ranges_);
+  pending_ranges_.clear();
+  const int n_b = static_cast<int>(ranges.size()), n_w = static_cast<int>(beam_ranges_m.size());
+
+  // Eq. 1-5, 7: augmented mean (noises zero-mean, eq. 4) and block-diagonal covariance.
+  const Eigen::Index l = kPose + kMotionNoise + n_b + n_w;
+  Eigen::VectorXd mean_a = Eigen::VectorXd::Zero(l);
+  mean_a.head<3>() = mean_;
+  Eigen::MatrixXd cov_a = Eigen::MatrixXd::Zero(l, l);
+  cov_a.topLeftCorner<3, 3>() = covariance_;
+  // Eq. 6, floored so that a robot at rest keeps a positive-definite augmented covariance.
+  const Eigen::Vector2d m = velocity_noise_variance(v, omega, params_.alpha).cwiseMax(1e-12);
+  cov_a.block<2, 2>(kPose, kPose) = m.asDiagonal();
+  // Eq. 7: variances (ERRATA: the paper's diagonal writes sigma where sigma^2 is meant).
+  for (int k = 0; k < n_b; ++k)
+    cov_a(kPose + kMotionNoise + k, kPose + kMotionNoise + k) = std::pow(params_.beacon_sigma_m, 2);
+  for (int k = 0; k < n_w; ++k) {
+    const Eigen::Index i = kPose + kMotionNoise + n_b + k;
+    cov_a(i, i) = std::pow(params_.laser_sigma_m, 2);
+  }
+  const UnscentedWeights w(l, params_.unscented);
+  const auto chi_a = sigma_points(mean_a, cov_a, w);  // eq. 2
+  if (!chi_a) return InputResult::rejected("covariance_not_positive_definite");
+  const Eigen::Index n_sigma = chi_a->cols();
+
+  // Eq. 9-11: every sigma point moved with its own velocity noise.
+  Eigen::MatrixXd chi_x(3, n_sigma);
+  for (Eigen::Index i = 0; i < n_sigma; ++i) {
+    if (i > 0 && chi_a->col(i).head<kPose + kMotionNoise>() == chi_a->col(0).head<kPose + kMotionNoise>()) {
+      chi_x.col(i) = chi_x.col(0);  // a point that spreads only measurement noise moves as the mean
+      continue;
+    }
+    chi_x.col(i) = predict_velocity_motion(Pose2(chi_a->col(i).head<3>()), v + (*chi_a)(kPose, i),
+                                           omega + (*chi_a)(kPose + 1, i), dt);
+  }
+  // Eq. 12-13, the heading averaged as offsets from the first sigma point (wrapped).
+  const double heading_ref = chi_x(2, 0);
+  Eigen::MatrixXd offsets = chi_x;
+  for (Eigen::Index i = 0; i < n_sigma; ++i) offsets(2, i) = wrap_angle_rad(chi_x(2, i) - heading_ref);
+  Pose2 prior = weighted_mean(offsets, w);
+  prior.z() = wrap_angle_rad(prior.z() + heading_ref);
+  Eigen::MatrixXd x_centred = chi_x.colwise() - Eigen::Vector3d(prior);
+  for (Eigen::Index i = 0; i < n_sigma; ++i) x_centred(2, i) = wrap_angle_rad(x_centred(2, i));
+  Cov3 prior_cov = weighted_cross_covariance(x_centred, x_centred, w);
+  prior_cov = 0.5 * (prior_cov + prior_cov.transpose());
+  mean_ = prior;
+  covariance_ = prior_cov;
+  pending_scan_.reset();
+  if (n_b + n_w == 0) return InputResult::ok();
+
+  // Table 2: the predicted range to every beacon over the sigma points, then each measured
+  // range's most likely beacon.
+  const std::vector<Beacon> beacons = map_.beacons();
+  std::vector<std::uint32_t> associated(n_b);
+  if (n_b > 0) {
+    std::vector<PredictedBeaconRange> predicted;
+    for (const Beacon& b : beacons) {
+      Eigen::VectorXd z(n_sigma);
+      for (Eigen::Index i = 0; i < n_sigma; ++i) {
+        z(i) = i > 0 && chi_x.col(i) == chi_x.col(0) ? z(0)
+                                                     : predict_range(Pose2(chi_x.col(i)), receiver_base_m_,
+                                                                     receiver_height_m_, b.position_map_m)
+                                                           .range_m;
+      }
+      const double mean_z = z.dot(w.mean);  // line 3
+      const Eigen::RowVectorXd centred = (z.array() - mean_z).matrix().transpose();
+      const double var_z = (centred * w.covariance.asDiagonal() * centred.transpose())(0, 0) +
+                           std::pow(params_.beacon_sigma_m, 2);  // line 4, with its noise (line 2)
+      predicted.push_back({b.id, mean_z, var_z});
+    }
+    for (int k = 0; k < n_b; ++k) {
+      const auto j = most_likely_beacon(ranges[k].range_m, predicted);  // lines 6-11
+      if (!j) return InputResult::rejected("no_beacon_to_associate");
+      associated[k] = *j;
+      associations_.push_back({ranges[k].stamp_ns, ranges[k].receiver_id, *j});
+    }
+  }
+
+  // Eq. 16-20: predicted measurements (beacon ranges, then beams) plus their noise sigma points.
+  const Eigen::Index n_z = n_b + n_w;
+  Eigen::MatrixXd z_sigma(n_z, n_sigma);
+  for (Eigen::Index i = 0; i < n_sigma; ++i) {
+    // The sigma points that spread only measurement noise (eq. 8's chi_n^B, chi_n^W) keep the
+    // mean's pose: their h is the first point's, computed once (exact, and 5x fewer rays).
+    if (i > 0 && chi_x.col(i) == chi_x.col(0)) {
+      z_sigma.col(i) = z_sigma.col(0);
+      continue;
+    }
+    const Pose2 pose(chi_x.col(i));
+    for (int k = 0; k < n_b; ++k) {
+      z_sigma(k, i) =
+          predict_range(pose, receiver_base_m_, receiver_height_m_, map_.find(associated[k])->position_map_m)
+              .range_m;
+    }
+    if (n_w > 0) expected_laser_ranges(*grid_, pose, laser, z_sigma.col(i).data() + n_b);
+  }
+  z_sigma += chi_a->bottomRows(n_z);  // eq. 16: + chi_n
+  Eigen::VectorXd z_measured(n_z);
+  for (int k = 0; k < n_b; ++k) z_measured(k) = ranges[k].range_m;
+  for (int k = 0; k < n_w; ++k) z_measured(n_b + k) = beam_ranges_m[k];
+  const Eigen::VectorXd z_mean = weighted_mean(z_sigma, w);  // eq. 18
+  const Eigen::MatrixXd z_centred = z_sigma.colwise() - z_mean;
+  const Eigen::MatrixXd s = weighted_cross_covariance(z_centred, z_centred, w);   // eq. 19
+  const Eigen::MatrixXd xz = weighted_cross_covariance(x_centred, z_centred, w);  // eq. 20
+  // Eq. 15 prints K = Sigma_xz S; the gain is Sigma_xz S^-1, from a checked LDLT of S.
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(s);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().array() > 0.0).all()) {
+    return InputResult::rejected("singular_innovation");
+  }
+  const Eigen::MatrixXd k_gain = ldlt.solve(xz.transpose()).transpose();
+  Pose2 posterior = prior + k_gain * (z_measured - z_mean);  // eq. 21
+  posterior.z() = wrap_angle_rad(posterior.z());
+  Cov3 posterior_cov = prior_cov - k_gain * s * k_gain.transpose();  // eq. 22
+  posterior_cov = 0.5 * (posterior_cov + posterior_cov.transpose());
+  if (Eigen::LLT<Cov3>(posterior_cov).info() != Eigen::Success)
+    return InputResult::rejected("covariance_not_positive_definite");
+  mean_ = posterior;
+  covariance_ = posterior_cov;
+  last_correction_stamp_ns_ = *timeline_.last_stamp_ns();
+  return InputResult::ok();
+}
+
+std::vector<Estimator::Association> UkfLrf::take_associations() {
+  std::vector<Association> out;
+  out.swap(associations_);
+  return out;
+}
+
+std::optional<PoseEstimate> UkfLrf::estimate() const {
+  if (!initialized_ || !timeline_.last_stamp_ns()) return std::nullopt;
+  return PoseEstimate{*timeline_.last_stamp_ns(), mean_, covariance_, status()};
+}
+
+PoseStatus UkfLrf::status() const {
+  if (!initialized_) return PoseStatus::kInitializing;
+  return staleness_.classify(timeline_.last_stamp_ns().value_or(last_correction_stamp_ns_),
+                             last_correction_stamp_ns_);
+}
+
+namespace {
+BEACONLOC_REGISTER_ESTIMATOR("ukf_lrf", "seed 001 UKF: anonymous beacon ranges and laser scans fused",
+                             [](const EstimatorConfig& c) {
+                               return std::make_unique<UkfLrf>(c, Mode::kFusion);
+                             });
+BEACONLOC_REGISTER_ESTIMATOR("ukf_lrf_laser_only", "seed 001 UKF on laser scans alone (the paper's case 5)",
+                             [](const EstimatorConfig& c) {
+                               return std::make_unique<UkfLrf>(c, Mode::kLaserOnly);
+                             });
+BEACONLOC_REGISTER_ESTIMATOR("ukf_lrf_beacons_only",
+                             "seed 001 UKF on anonymous beacon ranges alone (the paper's case 4)",
+                             [](const EstimatorConfig& c) {
+                               return std::make_unique<UkfLrf>(c, Mode::kBeaconsOnly);
+                             });
+}  // namespace
+
+}  // namespace beaconloc::ukf_lrf

@@ -1,0 +1,76 @@
+#pragma once
+// The UKF of seed 001 (Sensors 2015, "Sensor fusion of anonymous ultrasonic beacon ranges and
+// laser scans"): the pose [x, y, theta] augmented with the noise of the two odometry velocities
+// and one noise per range of the update (eq. 1-8), the scaled unscented transform (eq. 2, 12-14;
+// alpha = 0.6, kappa = 0, beta = 2 of eq. 23), the velocity motion model (eq. 9-11) with the
+// noise of eq. 6, anonymous beacon ranges associated by maximum likelihood (Table 2), laser
+// ranges by ray casting on the occupancy grid, and the correction of eq. 15-22 with whatever
+// measurements arrived since the last step (Sec. 4.1: asynchronous, the missing terms dropped).
+//
+// Modes (registered names): ukf_lrf (fusion), ukf_lrf_laser_only, ukf_lrf_beacons_only.
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "beacon_association.hpp"
+#include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/filters/unscented.hpp"
+#include "beaconloc/core/odometry_timeline.hpp"
+#include "laser_model.hpp"
+
+namespace beaconloc::ukf_lrf {
+
+enum class Mode { kFusion, kLaserOnly, kBeaconsOnly };
+
+struct UkfLrfParameters {
+  UnscentedParameters unscented;                        // eq. 23
+  std::array<double, 4> alpha{0.02, 0.02, 0.02, 0.02};  // eq. 6, Table 3 case 3
+  double beacon_sigma_m = 0.4;                          // sigma_nB, Table 3 case 3
+  double laser_sigma_m = 0.1;                           // sigma_nW, Table 3 case 3
+  // The paper places the robot at its initial pose by hand (Sec. 4.1): no estimate without
+  // EstimatorConfig::initial_pose (localizer --initial-pose).
+  std::optional<Pose2> initial_pose;
+  double initial_sigma_xy_m = 0.05;
+  double initial_sigma_yaw_rad = 0.05;
+  Pose2 laser_mount_base = Pose2::Zero();
+  double max_odometry_gap_s = 0.2;
+
+  static UkfLrfParameters from(const EstimatorConfig& config);
+};
+
+class UkfLrf final : public Estimator {
+ public:
+  UkfLrf(const EstimatorConfig& config, Mode mode);
+  std::string name() const override;
+  void set_beacon_map(const BeaconMap& map) override { map_ = map; }
+  InputResult predict(const OdometrySample& odometry) override;
+  InputResult update(const RangeMeasurement& range) override;
+  bool uses_laser() const override { return mode_ != Mode::kBeaconsOnly; }
+  InputResult update_laser(const LaserScanSample& scan) override;
+  std::vector<Association> take_associations() override;
+  std::optional<PoseEstimate> estimate() const override;
+  PoseStatus status() const override;
+
+ private:
+  // One step of Table 1: sigma points of the augmented state, the motion of eq. 9-11, and the
+  // correction with the pending measurements.
+  InputResult step(double v_mps, double omega_radps, double dt_s);
+
+  Mode mode_;
+  UkfLrfParameters params_;
+  std::shared_ptr<const OccupancyGrid> grid_;
+  Eigen::Vector2d receiver_base_m_ = Eigen::Vector2d::Zero();
+  double receiver_height_m_ = 0.0;
+  BeaconMap map_;
+  OdometryTimeline timeline_;
+  StalenessPolicy staleness_;
+  Pose2 mean_ = Pose2::Zero();
+  Cov3 covariance_ = Cov3::Identity();
+  bool initialized_ = false;
+  StampNs last_correction_stamp_ns_ = 0;
+  std::vector<RangeMeasurement> pending_ranges_;
+  std::optional<LaserScanSample> pending_scan_;
+  std::vector<Association> associations_;
+};
+
+}  // namespace beaconloc::ukf_lrf
