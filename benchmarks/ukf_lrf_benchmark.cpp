@@ -35,7 +35,7 @@ void BM_UkfLrfFusedUpdate(benchmark::State& state) {
   scan.range_min_m = 0.0f;
   scan.range_max_m = 80.0f;
   ukf_lrf::LaserBeams beams;
-  for (int i = 0; i < 19; ++i) beams.add_beam(scan.angle_min_rad + i * scan.angle_increment_rad);
+  for (int i = 0; i < 19; ++i) beams.add_beam(scan.angle_min_rad + static_cast<float>(i) * scan.angle_increment_rad);
   double expected[19];
   ukf_lrf::expected_laser_ranges(*scenario.map, pose, beams, expected);
   for (double r : expected) scan.ranges_m.push_back(static_cast<float>(r));

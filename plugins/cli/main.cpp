@@ -265,7 +265,7 @@ int run(int argc, char** argv) {
         sim::Scenario scenario = sim::load_scenario_file(file);
         if (accuracy_odometry_k_v_m) scenario.odometry_k_v_m = *accuracy_odometry_k_v_m;
         for (const auto& estimator : accuracy_estimators) {
-          AccuracyRow row{scenario.name, estimator, {}};
+          AccuracyRow row{scenario.name, estimator, {}, {}};
           for (int k = 0; k < accuracy_seeds; ++k) {
             const OfflineRunResult r =
                 run_scenario_offline(scenario, accuracy_first_seed + static_cast<std::uint64_t>(k), estimator,
