@@ -41,6 +41,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
   Robot* r = robot(robot_id, "odometry");
   if (!r) return std::nullopt;
   const InputResult result = r->estimator->predict(odometry);
+  for (const auto& reason : r->estimator->take_deferred_rejections()) counts_.reject("deferred." + reason);
   if (!result.accepted) {
     counts_.reject("odometry." + result.rejection);
     return std::nullopt;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/occupancy_grid_io.hpp"
@@ -85,8 +86,20 @@ TEST(OccupancyGridFile, RoundTripsAndRefusesMalformedFiles) {
   std::ofstream(dir / "short.pgm") << "P5\n10 10\n255\nabc";
   std::ofstream(dir / "short.yaml") << "image: short.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n";
   std::ofstream(dir / "bad_resolution.yaml") << "image: text.pgm\nresolution: -1\norigin: [0, 0, 0]\n";
+  std::ofstream(dir / "word_origin.yaml") << "image: text.pgm\nresolution: 1.0\norigin: [a, 0, 0]\n";
+  std::ofstream(dir / "threshold.yaml")
+      << "image: text.pgm\nresolution: 1.0\norigin: [0, 0, 0]\noccupied_thresh: 7\n";
+  std::ofstream(dir / "scale.yaml") << "image: text.pgm\nresolution: 1.0\norigin: [0, 0, 0]\nmode: scale\n";
+  std::ofstream(dir / "huge.pgm") << "P5\n100000 100000\n255\nabc";
+  std::ofstream(dir / "huge.yaml") << "image: huge.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n";
+  std::ofstream(dir / "bright.pgm") << "P5\n2 1\n100\n" << static_cast<char>(50) << static_cast<char>(200);
+  std::ofstream(dir / "bright.yaml") << "image: bright.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n";
+  std::ofstream(dir / "negate_true.yaml")
+      << "image: text.pgm\nresolution: 1.0\norigin: [0, 0, 0]\nnegate: true\n";
+  EXPECT_TRUE(load_occupancy_grid((dir / "negate_true.yaml").string()).occupied(1, 0));  // negated
   for (const char* name :
-       {"rotated.yaml", "no_image.yaml", "short.yaml", "bad_resolution.yaml", "missing.yaml"}) {
+       {"rotated.yaml", "no_image.yaml", "short.yaml", "bad_resolution.yaml", "missing.yaml",
+        "word_origin.yaml", "threshold.yaml", "scale.yaml", "huge.yaml", "bright.yaml"}) {
     EXPECT_THROW(load_occupancy_grid((dir / name).string()), MapFileError) << name;
   }
   std::filesystem::remove_all(dir);
@@ -123,6 +136,127 @@ TEST(UkfLrfEstimator, IsRegisteredInItsThreeModesAndRefusesWhatItCannotUse) {
   EXPECT_TRUE(placed->predict(o).accepted);
   ASSERT_TRUE(placed->estimate());
   EXPECT_EQ(placed->estimate()->pose_map_base, Pose2(1.0, 1.0, 0.0));
+}
+
+// A robot driving along a 4 m x 3 m room with two beacons far apart, fed exact scans and ranges:
+// the filter's full iteration (motion, association, correction) runs.
+class RoomDrive {
+ public:
+  explicit RoomDrive(const std::string& estimator) {
+    EstimatorConfig config;
+    config.receivers.receivers_base_m = {{0.0, 0.0}};
+    config.receivers.receiver_height_m = 0.3;
+    config.occupancy_grid = std::make_shared<const OccupancyGrid>(room());
+    config.initial_pose = truth_;
+    ukf_ = EstimatorRegistry::instance().create(estimator, config);
+    map_ = BeaconMap({{1, {0.5, 0.5, 2.5}}, {2, {3.5, 2.5, 2.5}}});
+    ukf_->set_beacon_map(map_);
+  }
+  InputResult odometry(StampNs stamp_ns, double v_mps) {
+    const double dt = static_cast<double>(stamp_ns - stamp_ns_) * 1e-9;
+    truth_.x() += v_mps * dt;
+    stamp_ns_ = stamp_ns;
+    OdometrySample o;
+    o.stamp_ns = stamp_ns;
+    o.wheel_base_m = 0.4;
+    o.wheel_velocity_right_mps = o.wheel_velocity_left_mps = v_mps;
+    return ukf_->predict(o);
+  }
+  LaserScanSample scan(StampNs stamp_ns, int beams = 19) const {
+    LaserScanSample s;
+    s.stamp_ns = stamp_ns;
+    s.angle_min_rad = static_cast<float>(-M_PI / 2);
+    s.angle_increment_rad = static_cast<float>(M_PI / (beams - 1));
+    s.range_max_m = 30.0f;
+    LaserBeams b;
+    for (int i = 0; i < beams; ++i)
+      b.add_beam(s.angle_min_rad + i * static_cast<double>(s.angle_increment_rad));
+    std::vector<double> r(static_cast<std::size_t>(beams));
+    expected_laser_ranges(room(), truth_, b, r.data());
+    for (double x : r) s.ranges_m.push_back(static_cast<float>(x));
+    return s;
+  }
+  RangeMeasurement range(StampNs stamp_ns, std::uint32_t beacon_id) const {
+    RangeMeasurement r;
+    r.stamp_ns = stamp_ns;
+    r.beacon_id = kBeaconUnidentified;  // anonymous
+    const Eigen::Vector3d d =
+        map_.find(beacon_id)->position_map_m - Eigen::Vector3d(truth_.x(), truth_.y(), 0.3);
+    r.range_m = d.norm();
+    r.variance_m2 = 0.16;
+    return r;
+  }
+  std::unique_ptr<Estimator> ukf_;
+  BeaconMap map_;
+  Pose2 truth_{0.6, 1.5, 0.0};
+  StampNs stamp_ns_ = 0;
+};
+
+TEST(UkfLrfEstimator, FusesScansAtTheirOwnStampAndAssociatesAnonymousRanges) {
+  RoomDrive drive("ukf_lrf");
+  ASSERT_TRUE(drive.odometry(0, 0.0).accepted);  // the time line's anchor
+  StampNs t = 0;
+  for (int k = 1; k <= 100; ++k) {
+    t += 22'000'000;
+    ASSERT_TRUE(drive.odometry(t, 0.4).accepted);
+    // The scan of this instant arrives after its odometry: fused at once, the covariance shrinks.
+    const double before = drive.ukf_->estimate()->covariance.trace();
+    ASSERT_TRUE(drive.ukf_->update_laser(drive.scan(t)).accepted);
+    EXPECT_LT(drive.ukf_->estimate()->covariance.trace(), before);
+    if (k % 10 == 0) {
+      ASSERT_TRUE(drive.ukf_->update(drive.range(t, k % 20 == 0 ? 1u : 2u)).accepted);
+    }
+  }
+  const PoseEstimate e = *drive.ukf_->estimate();
+  EXPECT_LT((e.pose_map_base.head<2>() - drive.truth_.head<2>()).norm(), 0.01);
+  EXPECT_LT(std::abs(wrap_angle_rad(e.pose_map_base.z() - drive.truth_.z())), 0.01);
+  // The anonymous ranges went to the right beacons (the two are 4.5 m apart).
+  const auto associations = drive.ukf_->take_associations();
+  ASSERT_EQ(associations.size(), 10u);
+  for (std::size_t i = 0; i < associations.size(); ++i)
+    EXPECT_EQ(associations[i].beacon_id, i % 2 == 0 ? 2u : 1u);
+  EXPECT_TRUE(drive.ukf_->take_associations().empty());  // taken
+}
+
+TEST(UkfLrfEstimator, HoldsAScanAheadOfTheOdometryRefusesStaleAndThinsLongScans) {
+  RoomDrive drive("ukf_lrf_laser_only");
+  ASSERT_TRUE(drive.odometry(0, 0.0).accepted);
+  ASSERT_TRUE(drive.odometry(22'000'000, 0.0).accepted);
+  const double before = drive.ukf_->estimate()->covariance.trace();
+  // Stamped after the filter's time: held, nothing fused yet.
+  ASSERT_TRUE(drive.ukf_->update_laser(drive.scan(44'000'000)).accepted);
+  EXPECT_EQ(drive.ukf_->estimate()->covariance.trace(), before);
+  ASSERT_TRUE(drive.odometry(44'000'000, 0.0).accepted);  // reaches its stamp: fused with the motion
+  EXPECT_LT(drive.ukf_->estimate()->covariance.trace(), before);
+  // Older than max_measurement_age_s (0.1 s) behind the filter: refused.
+  EXPECT_EQ(drive.ukf_->update_laser(drive.scan(-100'000'000)).rejection, "stale_scan");
+  // A 721-beam scan is thinned to the paper's 19 beams and still fuses.
+  EXPECT_TRUE(drive.ukf_->update_laser(drive.scan(44'000'000, 721)).accepted);
+  // Scans that cannot be used are refused by reason.
+  LaserScanSample all_nan = drive.scan(44'000'000);
+  for (auto& r : all_nan.ranges_m) r = std::nanf("");
+  EXPECT_EQ(drive.ukf_->update_laser(all_nan).rejection, "no_usable_beams");
+  LaserScanSample unbounded = drive.scan(44'000'000);
+  unbounded.range_max_m = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(drive.ukf_->update_laser(unbounded).rejection, "malformed_scan");
+  LaserScanSample no_increment = drive.scan(44'000'000);
+  no_increment.angle_increment_rad = 0.0f;
+  EXPECT_EQ(drive.ukf_->update_laser(no_increment).rejection, "malformed_scan");
+}
+
+TEST(UkfLrfEstimator, RefusesBadParametersAtStart) {
+  EstimatorConfig config;
+  config.receivers.receivers_base_m = {{0.0, 0.0}};
+  for (const auto& [name, value] : std::vector<std::pair<std::string, double>>{{"ut_alpha", 0.0},
+                                                                               {"initial_sigma_xy_m", 0.0},
+                                                                               {"alpha1", -0.01},
+                                                                               {"beacon_sigma_m", 0.0},
+                                                                               {"max_beams", 0.0},
+                                                                               {"ut_kappa", -10.0}}) {
+    config.parameters = {{name, value}};
+    EXPECT_THROW(EstimatorRegistry::instance().create("ukf_lrf_beacons_only", config), std::invalid_argument)
+        << name;
+  }
 }
 
 }  // namespace

@@ -68,6 +68,8 @@ std::optional<LocalizerOutput> OfflineStack::feed(const std::string& robot_id, c
     if (a.beacon_id == truth->second) ++c.correct;
     range_truth_.erase(truth);
   }
+  // Ranges never associated (refused, or a mode without beacons) are forgotten after 10 s.
+  range_truth_.erase(range_truth_.begin(), range_truth_.lower_bound(e.stamp_ns - 10'000'000'000));
   return pose;
 }
 

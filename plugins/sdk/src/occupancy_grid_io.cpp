@@ -71,14 +71,47 @@ OccupancyGrid load_occupancy_grid(const std::string& yaml_path) {
   if (!(resolution > 0.0)) fail(yaml_path, "'resolution' must be positive");
   const YAML::Node origin = root["origin"];
   if (!origin || !origin.IsSequence() || origin.size() != 3) fail(yaml_path, "'origin' must be [x, y, yaw]");
-  const double ox = origin[0].as<double>(), oy = origin[1].as<double>(), oyaw = origin[2].as<double>();
+  double ox = 0.0, oy = 0.0, oyaw = 0.0;
+  try {
+    ox = origin[0].as<double>();
+    oy = origin[1].as<double>();
+    oyaw = origin[2].as<double>();
+  } catch (const YAML::Exception&) {
+    fail(yaml_path, "'origin' must hold three numbers");
+  }
   if (!std::isfinite(ox) || !std::isfinite(oy) || oyaw != 0.0) {
     fail(yaml_path, "'origin' must be finite with yaw 0 (rotated maps are not supported)");
   }
   const double occupied_thresh = root["occupied_thresh"] ? number(root, "occupied_thresh", yaml_path) : 0.65;
-  const bool negate = root["negate"] && root["negate"].as<int>() != 0;
+  if (!(occupied_thresh >= 0.0 && occupied_thresh <= 1.0))
+    fail(yaml_path, "'occupied_thresh' must be in [0, 1]");
+  if (root["free_thresh"]) {
+    const double free_thresh = number(root, "free_thresh", yaml_path);
+    if (!(free_thresh >= 0.0 && free_thresh <= 1.0)) fail(yaml_path, "'free_thresh' must be in [0, 1]");
+  }
+  bool negate = false;
+  if (root["negate"]) {
+    try {
+      negate = root["negate"].as<int>() != 0;
+    } catch (const YAML::Exception&) {
+      try {
+        negate = root["negate"].as<bool>();
+      } catch (const YAML::Exception&) {
+        fail(yaml_path, "'negate' must be 0 or 1");
+      }
+    }
+  }
+  if (root["mode"] && root["mode"].as<std::string>("") != "trinary") {
+    fail(yaml_path, "only 'mode: trinary' (the default) is supported");
+  }
+  std::string image_name;
+  try {
+    image_name = root["image"].as<std::string>();
+  } catch (const YAML::Exception&) {
+    fail(yaml_path, "'image' must be a file name");
+  }
 
-  std::filesystem::path image = root["image"].as<std::string>();
+  std::filesystem::path image = image_name;
   if (image.is_relative()) image = std::filesystem::path(yaml_path).parent_path() / image;
   std::ifstream in(image, std::ios::binary);
   if (!in) fail(image.string(), "cannot open the map image");
@@ -88,12 +121,25 @@ OccupancyGrid load_occupancy_grid(const std::string& yaml_path) {
   const int height = header_number(in, image.string(), "height");
   const int max_value = header_number(in, image.string(), "maximum value");
   if (max_value > 255) fail(image.string(), "16-bit PGM is not supported");
-  std::vector<int> pixels(static_cast<std::size_t>(width) * height);
+  const std::size_t cells = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (magic == "P5") {  // the data must be there before anything is allocated for it
+    const auto here = in.tellg();
+    in.seekg(0, std::ios::end);
+    const auto size = in.tellg();
+    in.seekg(here);
+    if (size - here < static_cast<std::streamoff>(cells)) fail(image.string(), "truncated PGM data");
+  } else if (cells > 100'000'000) {
+    fail(image.string(), "more than 1e8 cells in a text PGM");
+  }
+  std::vector<int> pixels(cells);
   if (magic == "P5") {
     std::vector<unsigned char> raw(pixels.size());
     in.read(reinterpret_cast<char*>(raw.data()), static_cast<std::streamsize>(raw.size()));
     if (in.gcount() != static_cast<std::streamsize>(raw.size())) fail(image.string(), "truncated PGM data");
-    for (std::size_t i = 0; i < raw.size(); ++i) pixels[i] = raw[i];
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      if (raw[i] > max_value) fail(image.string(), "a pixel above the PGM's maximum value");
+      pixels[i] = raw[i];
+    }
   } else {
     for (auto& p : pixels) {
       if (!(in >> p) || p < 0 || p > max_value) fail(image.string(), "bad or truncated PGM data");

@@ -34,6 +34,8 @@ struct UkfLrfParameters {
   double initial_sigma_yaw_rad = 0.05;
   Pose2 laser_mount_base = Pose2::Zero();
   double max_odometry_gap_s = 0.2;
+  int max_beams = 19;                  // N_W of Sec. 3.4: longer scans are thinned evenly
+  double max_measurement_age_s = 0.1;  // a range or scan older than this behind the filter is stale
 
   static UkfLrfParameters from(const EstimatorConfig& config);
 };
@@ -48,13 +50,24 @@ class UkfLrf final : public Estimator {
   bool uses_laser() const override { return mode_ != Mode::kBeaconsOnly; }
   InputResult update_laser(const LaserScanSample& scan) override;
   std::vector<Association> take_associations() override;
+  std::vector<std::string> take_deferred_rejections() override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
 
  private:
-  // One step of Table 1: sigma points of the augmented state, the motion of eq. 9-11, and the
-  // correction with the pending measurements.
-  InputResult step(double v_mps, double omega_radps, double dt_s);
+  struct Motion {
+    double v_mps, omega_radps, dt_s;
+  };
+  struct ScanBeams {
+    LaserBeams beams;
+    std::vector<double> ranges_m;
+  };
+  // One iteration of Table 1: sigma points of the augmented state, the motion of eq. 9-11 (when
+  // there is one) and the correction with the measurements given (the missing terms dropped).
+  InputResult step(std::optional<Motion> motion, std::vector<RangeMeasurement> ranges, const ScanBeams* scan);
+  InputResult fuse_or_hold(std::vector<RangeMeasurement> ranges, std::optional<ScanBeams> beams,
+                           StampNs stamp_ns);
+  ScanBeams usable_beams(const LaserScanSample& scan) const;
 
   Mode mode_;
   UkfLrfParameters params_;
@@ -68,9 +81,12 @@ class UkfLrf final : public Estimator {
   Cov3 covariance_ = Cov3::Identity();
   bool initialized_ = false;
   StampNs last_correction_stamp_ns_ = 0;
-  std::vector<RangeMeasurement> pending_ranges_;
-  std::optional<LaserScanSample> pending_scan_;
+  std::vector<RangeMeasurement> pending_ranges_;  // stamped after the filter's time
+  std::optional<ScanBeams> pending_scan_;
+  StampNs pending_scan_stamp_ns_ = 0;
+  bool last_step_predicted_ = false;
   std::vector<Association> associations_;
+  std::vector<std::string> deferred_rejections_;
 };
 
 }  // namespace beaconloc::ukf_lrf

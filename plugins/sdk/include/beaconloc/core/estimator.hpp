@@ -74,6 +74,9 @@ class Estimator {
     std::uint32_t beacon_id;
   };
   virtual std::vector<Association> take_associations() { return {}; }
+  // Measurements held for a later step whose fusion then failed (the step itself succeeded),
+  // as rejection reasons since last asked: the localizer counts them.
+  virtual std::vector<std::string> take_deferred_rejections() { return {}; }
   // The current pose; nullopt until the estimator has one.
   virtual std::optional<PoseEstimate> estimate() const = 0;
   // Status from data time alone (the stamps pushed so far).
