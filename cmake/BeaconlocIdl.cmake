@@ -17,10 +17,11 @@ function(beaconloc_idl_library target)
     get_filename_component(stem ${idl} NAME_WE)
     set(outputs ${out_dir}/${stem}.h ${out_dir}/${stem}.cxx
                 ${out_dir}/${stem}PubSubTypes.h ${out_dir}/${stem}PubSubTypes.cxx)
+    get_filename_component(idl_dir ${abs} DIRECTORY)
     add_custom_command(
       OUTPUT ${outputs}
-      COMMAND ${FASTDDSGEN_EXECUTABLE} ${flags} ${abs}
-      DEPENDS ${abs}
+      COMMAND ${FASTDDSGEN_EXECUTABLE} ${flags} -I ${idl_dir} ${abs}
+      DEPENDS ${ARG_IDL}
       COMMENT "fastddsgen ${stem}.idl"
       VERBATIM)
     list(APPEND sources ${out_dir}/${stem}.cxx ${out_dir}/${stem}PubSubTypes.cxx)

@@ -9,4 +9,5 @@ $SUDO apt-get install -y --no-install-recommends \
   ca-certificates cmake g++ ninja-build make \
   libfastrtps-dev libfastcdr-dev fastddsgen \
   libeigen3-dev libcli11-dev libyaml-cpp-dev \
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev \
+  cyclonedds-dev cyclonedds-tools

@@ -7,8 +7,10 @@
 #include <iostream>
 #include <thread>
 
+#include "beaconloc/core/csv_reader.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/dds/stop_signal.hpp"
+#include "bridge_participant.hpp"
 #include "decoder_participant.hpp"
 #include "diagnostics_recorder.hpp"
 #include "localizer_participant.hpp"
@@ -107,6 +109,22 @@ void add_localizer_options(CLI::App* app, LocalizerSettings& o, bool standalone)
   app->add_option("--receiver-height-m", o.receiver_height_m, "receivers' height above the floor");
 }
 
+void add_bridge_options(CLI::App* app, bridge::BridgeOptions& o, LocalizerSettings& receivers) {
+  app->add_option("--robot", o.robot_id, "the robot whose estimates and odometry this bridge speaks for");
+  app->add_option("--namespace", o.ros_namespace, "ROS 2 namespace: rt/<ns>/beacon_pose (default: none)");
+  app->add_option("--map-frame", o.map_frame, "map frame (REP-105)");
+  app->add_option("--odom-frame", o.odom_frame, "odometry frame (REP-105)");
+  app->add_option("--base-frame", o.base_frame, "robot base frame (REP-105)");
+  app->add_option("--receivers", receivers.receivers, "receivers in the robot frame, x:y[,x:y...] (m)");
+  app->add_option("--receiver-height-m", receivers.receiver_height_m, "receivers' height above the floor");
+  app->add_flag("--odom-in", o.odometry_in,
+                "feed the localizer from rt/<ns>/odom (nav_msgs/Odometry of the robot's driver)");
+  app->add_flag("--scan-in", o.scan_in, "feed the localizer from rt/<ns>/scan (sensor_msgs/LaserScan)");
+  app->add_option("--wheel-base-m", o.wheel_base_m,
+                  "wheel base to express the driver's twist as wheel speeds")
+      ->check(kPositive);
+}
+
 void run_until_stopped() {
   while (!dds::wait_for_stop(1s)) {
   }
@@ -149,8 +167,25 @@ int run(int argc, char** argv) {
   add_localizer_options(localizer, localizer_settings, true);
   localizer->add_flag("--list-estimators", list_estimators, "print the estimators and exit");
 
+  bridge::BridgeOptions bridge_options;
+  LocalizerSettings bridge_receivers;
+  auto* bridge_cmd = app.add_subcommand(
+      "bridge",
+      "ROS 2 bridge: estimates, map -> odom, beacons and ranges as ROS 2 topics; a ROS 2 robot's odom "
+      "and scan in");
+  add_dds_options(bridge_cmd, dds_options);
+  add_bridge_options(bridge_cmd, bridge_options, bridge_receivers);
+  std::string bridge_beacons_file;
+  bridge_cmd
+      ->add_option("--beacons", bridge_beacons_file,
+                   "beacons CSV (beacon_id,x_m,y_m,z_m) to draw when no gateway publishes the beacon map")
+      ->check(CLI::ExistingFile);
+  bool with_bridge = false;
+
   auto* demo =
       app.add_subcommand("demo", "the whole pipeline in one process on the built-in scenario, in real time");
+  demo->add_flag("--bridge", with_bridge,
+                 "also run the ROS 2 bridge in this process (ROS 2 tools see the demo)");
   add_dds_options(demo, dds_options);
   add_gateway_options(demo, gateway_options, seed);
   add_localizer_options(demo, localizer_settings, false);
@@ -167,6 +202,7 @@ int run(int argc, char** argv) {
   add_localizer_options(run_cmd, localizer_settings, false);
   run_cmd->add_option("--out", out_dir, "output directory")->required();
   run_cmd->add_flag("--processes", processes, "one process per participant (needs --speed)");
+  run_cmd->add_flag("--bridge", with_bridge, "also run the ROS 2 bridge (in the run's process)");
 
   auto* eval =
       app.add_subcommand("eval", "score an estimate CSV against a truth CSV: metrics.json and plots");
@@ -234,6 +270,13 @@ int run(int argc, char** argv) {
       }
       participant.stop();
       participant.rethrow_failure();
+      return 0;
+    }
+    if (bridge_cmd->parsed()) {
+      bridge_options.receivers = bridge_receivers.config().receivers;
+      if (!bridge_beacons_file.empty()) bridge_options.beacons = load_beacon_map_csv(bridge_beacons_file);
+      bridge::BridgeParticipant participant(dds_options, bridge_options);
+      run_until_stopped();
       return 0;
     }
     if (decoder->parsed()) {
@@ -324,6 +367,11 @@ int run(int argc, char** argv) {
       o.localizer = localizer_settings;
       o.out_dir = out_dir;
       o.processes = processes;
+      if (with_bridge && processes) {
+        throw std::invalid_argument(
+            "--bridge runs in the run's process; with --processes start `beaconloc bridge`");
+      }
+      if (with_bridge) o.bridge = bridge::BridgeOptions{};
       LoadedSource source = load_source(source_choice, seed);
       o.gateway = gateway_options;
       o.gateway.seed = source.seed;

@@ -158,6 +158,13 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
     config.occupancy_grid = std::make_shared<const OccupancyGrid>(*source.scenario->map);
   }
   LocalizerParticipant localizer(o.dds, LocalizerCore(o.localizer.estimator, config, o.localizer.robot));
+  std::unique_ptr<bridge::BridgeParticipant> ros2_bridge;
+  if (o.bridge) {
+    bridge::BridgeOptions b = *o.bridge;
+    b.receivers = config.receivers;
+    b.robot_id = o.gateway.robot_id;
+    ros2_bridge = std::make_unique<bridge::BridgeParticipant>(o.dds, b);
+  }
   DecoderParticipant decoder(o.dds, o.decoder);
   PoseRecorder recorder(o.dds);
   DiagnosticsRecorder diagnostics(o.dds);

@@ -8,6 +8,7 @@
 
 #include "beaconloc/core/estimator.hpp"
 #include "beaconloc/dds/participant.hpp"
+#include "bridge_participant.hpp"
 #include "evaluation.hpp"
 #include "gateway_participant.hpp"
 #include "replay/replay_source.hpp"
@@ -56,6 +57,7 @@ struct LocalizerSettings {
 
 struct PipelineOptions {
   dds::DdsOptions dds;
+  std::optional<bridge::BridgeOptions> bridge;  // the ROS 2 bridge in the same process (demo)
   GatewayOptions gateway;
   TofDecoderConfig decoder;
   LocalizerSettings localizer;

@@ -78,6 +78,18 @@ void LocalizerCore::on_laser(const std::string& robot_id, const LaserScanSample&
   counts_.accept();
 }
 
+void LocalizerCore::on_initial_pose(const std::string& robot_id, StampNs stamp_ns, const Pose2& pose,
+                                    const Cov3& covariance) {
+  Robot* r = robot(robot_id, "initial_pose");
+  if (!r) return;
+  const InputResult result = r->estimator->reset(stamp_ns, pose, covariance);
+  if (!result.accepted) {
+    counts_.reject("initial_pose." + result.rejection);
+    return;
+  }
+  counts_.accept();
+}
+
 std::vector<Estimator::Association> LocalizerCore::take_associations(const std::string& robot_id) {
   auto it = robots_.find(robot_id);
   return it == robots_.end() ? std::vector<Estimator::Association>{}

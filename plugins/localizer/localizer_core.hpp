@@ -34,6 +34,9 @@ class LocalizerCore {
   // Laser scans reach estimators that use them (uses_laser()); others never see one.
   bool uses_laser() const { return uses_laser_; }
   void on_laser(const std::string& robot_id, const LaserScanSample& scan);
+  // Restarts the robot's estimator from a given pose (counted as initial_pose.<reason> if refused).
+  void on_initial_pose(const std::string& robot_id, StampNs stamp_ns, const Pose2& pose_map_base,
+                       const Cov3& covariance);
   // The robot's estimator's associations of anonymous ranges since last asked (evaluation).
   std::vector<Estimator::Association> take_associations(const std::string& robot_id);
 

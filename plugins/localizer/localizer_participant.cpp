@@ -33,6 +33,13 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       core_.on_laser(m.robot_id(), dds::from_msg(m));
     });
   }
+  participant_.subscribe<msg::InitialPosePubSubType>(
+      dds::kInitialPoseTopic, [this](const msg::InitialPose& m) {
+        Cov3 c;
+        for (int i = 0; i < 9; ++i) c(i / 3, i % 3) = m.covariance()[static_cast<std::size_t>(i)];
+        std::lock_guard<std::mutex> lock(mutex_);
+        core_.on_initial_pose(m.robot_id(), m.stamp_ns(), Pose2(m.x_m(), m.y_m(), m.yaw_rad()), c);
+      });
   diagnostics_ =
       std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] { return diagnostics_snapshot(); });
 }

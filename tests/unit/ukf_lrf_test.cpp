@@ -244,6 +244,30 @@ TEST(UkfLrfEstimator, HoldsAScanAheadOfTheOdometryRefusesStaleAndThinsLongScans)
   EXPECT_EQ(drive.ukf_->update_laser(no_increment).rejection, "malformed_scan");
 }
 
+TEST(UkfLrfEstimator, EveryPlaceableEstimatorRestartsFromAGivenPose) {
+  EstimatorConfig config;
+  config.receivers = ReceiverArray::on_circle(0.19, 3);
+  config.occupancy_grid = std::make_shared<const OccupancyGrid>(room());
+  for (const char* name : {"ukf_lrf_beacons_only", "range_ekf", "duhl"}) {
+    EstimatorConfig c = config;
+    if (std::string(name) == "ukf_lrf_beacons_only") c.receivers.receivers_base_m = {{0.0, 0.0}};
+    auto e = EstimatorRegistry::instance().create(name, c);
+    OdometrySample o;
+    o.wheel_base_m = 0.4;
+    EXPECT_EQ(e->reset(0, Pose2(1.0, 2.0, std::nan("")), 0.01 * Cov3::Identity()).rejection,
+              "invalid_initial_pose")
+        << name;
+    Cov3 not_positive = Cov3::Identity();
+    not_positive(2, 2) = -1.0;
+    EXPECT_EQ(e->reset(0, Pose2(1.0, 2.0, 0.3), not_positive).rejection, "invalid_initial_pose") << name;
+    ASSERT_TRUE(e->reset(0, Pose2(1.0, 2.0, 0.3), 0.01 * Cov3::Identity()).accepted) << name;
+    ASSERT_TRUE(e->predict(o).accepted) << name;
+    ASSERT_TRUE(e->estimate()) << name;
+    EXPECT_TRUE(e->estimate()->pose_map_base.isApprox(Pose2(1.0, 2.0, 0.3), 1e-12)) << name;
+    EXPECT_EQ(e->estimate()->covariance, 0.01 * Cov3::Identity()) << name;
+  }
+}
+
 TEST(UkfLrfEstimator, RefusesBadParametersAtStart) {
   EstimatorConfig config;
   config.receivers.receivers_base_m = {{0.0, 0.0}};

@@ -1,5 +1,6 @@
 #include "beaconloc/core/estimator.hpp"
 
+#include <Eigen/Cholesky>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
@@ -82,6 +83,14 @@ std::vector<std::string> EstimatorRegistry::names() const {
 std::string EstimatorRegistry::description(const std::string& name) const {
   auto it = entries_.find(name);
   return it == entries_.end() ? std::string() : it->second.description;
+}
+
+InputResult check_initial_pose(const Pose2& pose, const Cov3& c) {
+  if (!pose.allFinite() || !c.allFinite() || !c.isApprox(c.transpose(), 1e-9) ||
+      Eigen::LLT<Cov3>(c).info() != Eigen::Success) {
+    return InputResult::rejected("invalid_initial_pose");
+  }
+  return InputResult::ok();
 }
 
 }  // namespace beaconloc

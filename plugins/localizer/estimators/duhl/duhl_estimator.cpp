@@ -217,6 +217,15 @@ void Duhl::observe() {
   }
 }
 
+InputResult Duhl::reset(StampNs stamp_ns, const Pose2& pose, const Cov3& covariance) {
+  if (const InputResult checked = check_initial_pose(pose, covariance); !checked.accepted) return checked;
+  ekf_.reset(pose, covariance);  // the distance estimates stay: they come from the measurements
+  initialized_ = true;
+  consecutive_gated_ = 0;
+  last_correction_stamp_ns_ = timeline_.last_stamp_ns().value_or(stamp_ns);
+  return InputResult::ok();
+}
+
 std::optional<PoseEstimate> Duhl::estimate() const {
   if (!initialized_ || !timeline_.last_stamp_ns()) return std::nullopt;
   return PoseEstimate{*timeline_.last_stamp_ns(), ekf_.state(), ekf_.covariance(), status()};

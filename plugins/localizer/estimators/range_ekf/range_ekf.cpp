@@ -151,6 +151,15 @@ void RangeEkf::try_initialize() {
                                        timeline_.last_stamp_ns().value_or(window_.back().range.stamp_ns));
 }
 
+InputResult RangeEkf::reset(StampNs stamp_ns, const Pose2& pose, const Cov3& covariance) {
+  if (const InputResult checked = check_initial_pose(pose, covariance); !checked.accepted) return checked;
+  ekf_.reset(pose, covariance);  // the global fix is not needed: the pose was given
+  initialized_ = true;
+  consecutive_gated_ = 0;
+  last_correction_stamp_ns_ = timeline_.last_stamp_ns().value_or(stamp_ns);
+  return InputResult::ok();
+}
+
 std::optional<PoseEstimate> RangeEkf::estimate() const {
   if (!initialized_ || !timeline_.last_stamp_ns()) return std::nullopt;
   PoseEstimate e;

@@ -38,6 +38,7 @@ class RangeEkf final : public Estimator {
   void set_beacon_map(const BeaconMap& map) override { map_ = map; }
   InputResult predict(const OdometrySample& odometry) override;
   InputResult update(const RangeMeasurement& range) override;
+  InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
 

@@ -337,6 +337,16 @@ std::vector<Estimator::Association> UkfLrf::take_associations() {
   return out;
 }
 
+InputResult UkfLrf::reset(StampNs stamp_ns, const Pose2& pose, const Cov3& covariance) {
+  if (const InputResult checked = check_initial_pose(pose, covariance); !checked.accepted) return checked;
+  mean_ = pose;  // placed by hand again (Sec. 4.1)
+  mean_.z() = wrap_angle_rad(mean_.z());
+  covariance_ = covariance;
+  initialized_ = true;
+  last_correction_stamp_ns_ = timeline_.last_stamp_ns().value_or(stamp_ns);
+  return InputResult::ok();
+}
+
 std::optional<PoseEstimate> UkfLrf::estimate() const {
   if (!initialized_ || !timeline_.last_stamp_ns()) return std::nullopt;
   return PoseEstimate{*timeline_.last_stamp_ns(), mean_, covariance_, status()};

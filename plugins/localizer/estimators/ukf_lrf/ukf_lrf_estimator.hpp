@@ -51,6 +51,7 @@ class UkfLrf final : public Estimator {
   InputResult update_laser(const LaserScanSample& scan) override;
   std::vector<Association> take_associations() override;
   std::vector<std::string> take_deferred_rejections() override;
+  InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
 

@@ -9,6 +9,7 @@
 namespace beaconloc::embedded {
 extern const std::string_view kLoopbackProfilesXml;
 extern const std::string_view kTopicProfilesXml;
+extern const std::string_view kRos2TopicProfilesXml;
 }  // namespace beaconloc::embedded
 
 namespace beaconloc::dds {
@@ -21,7 +22,8 @@ void load_qos_profiles(const std::vector<std::string>& extra_files) {
   std::lock_guard<std::mutex> lock(mutex);
   auto* factory = DomainParticipantFactory::get_instance();
   if (!embedded_loaded) {
-    for (std::string_view xml : {embedded::kLoopbackProfilesXml, embedded::kTopicProfilesXml}) {
+    for (std::string_view xml :
+         {embedded::kLoopbackProfilesXml, embedded::kTopicProfilesXml, embedded::kRos2TopicProfilesXml}) {
       if (factory->load_XML_profiles_string(xml.data(), xml.size()) != ReturnCode_t::RETCODE_OK) {
         throw DdsError("the embedded QoS profiles failed to load");
       }

@@ -77,6 +77,12 @@ class Estimator {
   // Measurements held for a later step whose fusion then failed (the step itself succeeded),
   // as rejection reasons since last asked: the localizer counts them.
   virtual std::vector<std::string> take_deferred_rejections() { return {}; }
+  // Restart from this pose (an operator's or rviz2's initial pose), stamped stamp_ns; the
+  // estimators that cannot be placed refuse with a reason.
+  virtual InputResult reset(StampNs /*stamp_ns*/, const Pose2& /*pose_map_base*/,
+                            const Cov3& /*covariance*/) {
+    return InputResult::rejected("reset_unsupported");
+  }
   // The current pose; nullopt until the estimator has one.
   virtual std::optional<PoseEstimate> estimate() const = 0;
   // Status from data time alone (the stamps pushed so far).
@@ -86,6 +92,10 @@ class Estimator {
 // The checks every range-based estimator makes of a range: finite, positive, from an identified
 // beacon of the map, to a receiver the robot has. Accepted, or the typed rejection.
 InputResult check_range(const RangeMeasurement& range, const BeaconMap& map, std::size_t receiver_count);
+
+// The checks of a pose to reset an estimator from: finite, and a symmetric positive-definite
+// covariance. Accepted, or rejected("invalid_initial_pose").
+InputResult check_initial_pose(const Pose2& pose_map_base, const Cov3& covariance);
 
 // Status policy shared by estimators: how long without a fused range the pose stays OK.
 struct StalenessPolicy {

@@ -15,6 +15,8 @@ inline constexpr TopicSpec kOdometryTopic{"beaconloc/odometry", "odometry.writer
 inline constexpr TopicSpec kLaserScanTopic{"beaconloc/laser_scan", "laser_scan.writer", "laser_scan.reader"};
 inline constexpr TopicSpec kPoseEstimateTopic{"beaconloc/pose_estimate", "pose_estimate.writer",
                                               "pose_estimate.reader"};
+inline constexpr TopicSpec kInitialPoseTopic{"beaconloc/initial_pose", "initial_pose.writer",
+                                             "initial_pose.reader"};
 inline constexpr TopicSpec kBeaconMapTopic{"beaconloc/beacon_map", "beacon_map.writer", "beacon_map.reader"};
 inline constexpr TopicSpec kDiagnosticsTopic{"beaconloc/diagnostics", "diagnostics.writer",
                                              "diagnostics.reader"};

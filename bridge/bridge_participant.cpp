@@ -1,0 +1,210 @@
+#include "bridge_participant.hpp"
+
+#include <beaconlocPubSubTypes.h>
+
+#include "beaconloc/dds/convert.hpp"
+#include "beaconloc/dds/topics.hpp"
+#include "beaconloc/dds/wall_clock.hpp"
+#include "ros2_convert.hpp"
+
+namespace beaconloc::bridge {
+
+std::string ros_topic(const std::string& ns, const std::string& name) {
+  return ns.empty() ? "rt/" + name : "rt/" + ns + "/" + name;
+}
+
+BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions options)
+    : options_(std::move(options)),
+      beacon_pose_topic_(ros_topic(options_.ros_namespace, "beacon_pose")),
+      odometry_out_topic_(ros_topic(options_.ros_namespace, "odometry/beacons")),
+      beacons_topic_(ros_topic(options_.ros_namespace, "beacons")),
+      ranges_topic_(ros_topic(options_.ros_namespace, "beacon_ranges")),
+      odom_in_topic_(ros_topic(options_.ros_namespace, "odom")),
+      scan_in_topic_(ros_topic(options_.ros_namespace, "scan")),
+      initial_pose_topic_(ros_topic(options_.ros_namespace, "initialpose")),
+      participant_(dds, "beaconloc.bridge." + options_.robot_id) {
+  using geometry_msgs::msg::PoseWithCovarianceStampedPubSubType;
+  beacon_pose_writer_ = participant_.writer<PoseWithCovarianceStampedPubSubType>(
+      {beacon_pose_topic_.c_str(), "ros2.beacon_pose.writer", ""});
+  odometry_out_writer_ = participant_.writer<nav_msgs::msg::OdometryPubSubType>(
+      {odometry_out_topic_.c_str(), "ros2.odometry_beacons.writer", ""});
+  tf_writer_ = participant_.writer<tf2_msgs::msg::TFMessagePubSubType>({"rt/tf", "ros2.tf.writer", ""});
+  tf_static_writer_ =
+      participant_.writer<tf2_msgs::msg::TFMessagePubSubType>({"rt/tf_static", "ros2.tf_static.writer", ""});
+  beacons_writer_ = participant_.writer<visualization_msgs::msg::MarkerArrayPubSubType>(
+      {beacons_topic_.c_str(), "ros2.beacons.writer", ""});
+  ranges_writer_ = participant_.writer<sensor_msgs::msg::RangePubSubType>(
+      {ranges_topic_.c_str(), "ros2.beacon_ranges.writer", ""});
+  if (options_.odometry_in) {
+    odometry_in_writer_ = participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic);
+    participant_.subscribe<nav_msgs::msg::OdometryPubSubType>(
+        {odom_in_topic_.c_str(), "", "ros2.odom.reader"},
+        [this](const nav_msgs::msg::Odometry& m) { on_ros_odometry(m); });
+  }
+  if (options_.scan_in) {
+    scan_in_writer_ = participant_.writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic);
+    participant_.subscribe<sensor_msgs::msg::LaserScanPubSubType>(
+        {scan_in_topic_.c_str(), "", "ros2.scan.reader"},
+        [this](const sensor_msgs::msg::LaserScan& m) { on_ros_scan(m); });
+  }
+  initial_pose_writer_ = participant_.writer<msg::InitialPosePubSubType>(dds::kInitialPoseTopic);
+  participant_.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+      {initial_pose_topic_.c_str(), "", "ros2.initialpose.reader"},
+      [this](const geometry_msgs::msg::PoseWithCovarianceStamped& m) { on_ros_initial_pose(m); });
+  participant_.subscribe<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic,
+                                                      [this](const msg::PoseEstimate& m) { on_pose(m); });
+  participant_.subscribe<msg::OdometryPubSubType>(dds::kOdometryTopic,
+                                                  [this](const msg::Odometry& m) { on_odometry(m); });
+  participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic,
+                                                   [this](const msg::BeaconMap& m) { on_beacon_map(m); });
+  participant_.subscribe<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic,
+                                                     [this](const msg::BeaconRange& m) { on_range(m); });
+  publish_static_frames();
+  if (options_.beacons) {
+    auto markers = beacon_markers(*options_.beacons, options_.map_frame, dds::wall_clock_ns());
+    beacons_writer_->write(&markers);
+  }
+  diagnostics_ =
+      std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] { return diagnostics_snapshot(); });
+}
+
+BridgeParticipant::~BridgeParticipant() {
+  diagnostics_->stop();
+  participant_.close();
+}
+
+void BridgeParticipant::publish_static_frames() {
+  // base_link -> receiver_<i>, all in one message (tf2's convention for /tf_static).
+  tf2_msgs::msg::TFMessage frames;
+  for (std::size_t i = 0; i < options_.receivers.size(); ++i) {
+    const Eigen::Vector2d& r = options_.receivers.receivers_base_m[i];
+    frames.transforms().push_back(to_transform(0, Pose2(r.x(), r.y(), 0.0), options_.base_frame,
+                                               "receiver_" + std::to_string(i),
+                                               options_.receivers.receiver_height_m));
+  }
+  tf_static_writer_->write(&frames);
+}
+
+void BridgeParticipant::on_pose(const msg::PoseEstimate& m) {
+  if (m.robot_id() != options_.robot_id) return;
+  const PoseEstimate e = dds::from_msg(m);
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto pose = to_pose_with_covariance(e, options_.map_frame);
+  beacon_pose_writer_->write(&pose);
+  auto odometry =
+      to_ros_odometry(e, odom_.v_mps(), odom_.omega_radps(), options_.map_frame, options_.base_frame);
+  odometry_out_writer_->write(&odometry);
+  if (pending_transforms_.size() >= 100) {  // 1 s at 100 Hz without odometry: give the oldest up
+    pending_transforms_.pop_front();
+    counts_.reject("pose.no_odometry_at_stamp");  // beacon_pose went out; map -> odom could not
+  }
+  pending_transforms_.push_back(e);
+  publish_pending_transforms();
+}
+
+void BridgeParticipant::publish_pending_transforms() {
+  const auto latest = odom_.latest_stamp_ns();
+  while (!pending_transforms_.empty() && latest && pending_transforms_.front().stamp_ns <= *latest) {
+    const PoseEstimate e = pending_transforms_.front();
+    pending_transforms_.pop_front();
+    if (const auto map_odom = odom_.pose_map_odom(e.stamp_ns, e.pose_map_base)) {
+      tf2_msgs::msg::TFMessage tf;
+      tf.transforms().push_back(to_transform(e.stamp_ns, *map_odom, options_.map_frame, options_.odom_frame));
+      tf_writer_->write(&tf);
+      counts_.accept();
+    } else {
+      counts_.reject("pose.older_than_the_odometry_history");
+    }
+  }
+}
+
+void BridgeParticipant::on_odometry(const msg::Odometry& m) {
+  if (m.robot_id() != options_.robot_id || options_.odometry_in) return;  // the driver's pose is used then
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!odom_.add_wheel_odometry(dds::from_msg(m))) counts_.reject("odometry.out_of_order_or_invalid");
+  publish_pending_transforms();
+}
+
+void BridgeParticipant::on_beacon_map(const msg::BeaconMap& m) {
+  auto markers = beacon_markers(dds::from_msg(m), options_.map_frame, dds::wall_clock_ns());
+  std::lock_guard<std::mutex> lock(mutex_);
+  beacons_writer_->write(&markers);
+}
+
+void BridgeParticipant::on_range(const msg::BeaconRange& m) {
+  if (m.robot_id() != options_.robot_id) return;
+  const RangeMeasurement r = dds::from_msg(m);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (r.receiver_id >= options_.receivers.size()) {
+    counts_.reject("range.unknown_receiver");
+    return;
+  }
+  auto range = to_ros_range(r, "receiver_" + std::to_string(r.receiver_id), options_.range_field_of_view_rad,
+                            options_.range_min_m, options_.range_max_m);
+  ranges_writer_->write(&range);
+}
+
+void BridgeParticipant::on_ros_odometry(const nav_msgs::msg::Odometry& m) {
+  std::string why;
+  const auto o = from_ros_odometry(m, options_.wheel_base_m, &why);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!o) {
+    counts_.reject("odom." + why);
+    return;
+  }
+  const auto yaw = planar_yaw(m.pose().pose().orientation());
+  if (!yaw || !odom_.add_odom_pose(
+                  o->stamp_ns, Pose2(m.pose().pose().position().x(), m.pose().pose().position().y(), *yaw))) {
+    counts_.reject("odom.bad_or_out_of_order_pose");
+    return;
+  }
+  auto out = dds::to_msg(options_.robot_id, *o, ++odometry_sequence_);
+  odometry_in_writer_->write(&out);
+  counts_.accept();
+  publish_pending_transforms();
+}
+
+void BridgeParticipant::on_ros_scan(const sensor_msgs::msg::LaserScan& m) {
+  std::string why;
+  const auto s = from_ros_scan(m, &why);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!s) {
+    counts_.reject("scan." + why);
+    return;
+  }
+  auto out = dds::to_msg(options_.robot_id, *s);
+  scan_in_writer_->write(&out);
+  counts_.accept();
+}
+
+void BridgeParticipant::on_ros_initial_pose(const geometry_msgs::msg::PoseWithCovarianceStamped& m) {
+  std::string why;
+  const auto init = from_initial_pose(m, &why);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!init) {
+    counts_.reject("initialpose." + why);
+    return;
+  }
+  if (m.header().frame_id() != options_.map_frame) {
+    counts_.reject("initialpose.not_in_the_map_frame");  // no TF tree here to transform it
+    return;
+  }
+  msg::InitialPose out;
+  out.robot_id(options_.robot_id);
+  out.stamp_ns(init->stamp_ns);
+  out.x_m(init->pose_map_base.x());
+  out.y_m(init->pose_map_base.y());
+  out.yaw_rad(init->pose_map_base.z());
+  for (int i = 0; i < 9; ++i) out.covariance()[static_cast<std::size_t>(i)] = init->covariance(i / 3, i % 3);
+  initial_pose_writer_->write(&out);
+  counts_.accept();
+}
+
+msg::Diagnostics BridgeParticipant::diagnostics_snapshot() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts_, 0,
+                               msg::PARTICIPANT_STATUS_OK,
+                               std::string("ROS 2 ") + kRos2Distro + " layouts, robot " + options_.robot_id);
+}
+
+}  // namespace beaconloc::bridge

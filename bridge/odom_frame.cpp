@@ -1,0 +1,64 @@
+#include "odom_frame.hpp"
+
+#include <cmath>
+
+#include "beaconloc/core/models/diff_drive_motion.hpp"
+
+namespace beaconloc::bridge {
+
+Pose2 inverse(const Pose2& t) {
+  const double c = std::cos(t.z()), s = std::sin(t.z());
+  return {-c * t.x() - s * t.y(), s * t.x() - c * t.y(), wrap_angle_rad(-t.z())};
+}
+
+bool OdomFrame::push(StampNs stamp_ns, const Pose2& pose) {
+  if (!poses_.empty() && stamp_ns <= poses_.back().first) return false;
+  poses_.emplace_back(stamp_ns, pose);
+  while (poses_.size() > 2 && poses_.front().first < stamp_ns - history_ns_) poses_.pop_front();
+  return true;
+}
+
+bool OdomFrame::add_wheel_odometry(const OdometrySample& o) {
+  if (!(o.wheel_base_m > 0.0) || !std::isfinite(o.wheel_velocity_right_mps) ||
+      !std::isfinite(o.wheel_velocity_left_mps)) {
+    return false;
+  }
+  Pose2 pose = Pose2::Zero();
+  if (!poses_.empty()) {
+    if (o.stamp_ns <= poses_.back().first) return false;
+    const double dt = static_cast<double>(o.stamp_ns - poses_.back().first) * 1e-9;
+    pose = predict_diff_drive(poses_.back().second, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
+                              o.wheel_base_m, dt)
+               .pose;
+  }
+  v_mps_ = (o.wheel_velocity_right_mps + o.wheel_velocity_left_mps) / 2.0;
+  omega_radps_ = (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / o.wheel_base_m;
+  return push(o.stamp_ns, pose);
+}
+
+bool OdomFrame::add_odom_pose(StampNs stamp_ns, const Pose2& pose) {
+  return pose.allFinite() && push(stamp_ns, pose);
+}
+
+std::optional<Pose2> OdomFrame::pose_odom_base(StampNs stamp_ns) const {
+  if (poses_.empty() || stamp_ns < poses_.front().first || stamp_ns > poses_.back().first)
+    return std::nullopt;
+  for (std::size_t i = 1; i < poses_.size(); ++i) {
+    if (poses_[i].first < stamp_ns) continue;
+    const auto& [t0, p0] = poses_[i - 1];
+    const auto& [t1, p1] = poses_[i];
+    const double a = static_cast<double>(stamp_ns - t0) / static_cast<double>(t1 - t0);
+    Pose2 p = p0 + a * (p1 - p0);
+    p.z() = wrap_angle_rad(p0.z() + a * wrap_angle_rad(p1.z() - p0.z()));
+    return p;
+  }
+  return poses_.back().second;  // stamp_ns equals the only sample's
+}
+
+std::optional<Pose2> OdomFrame::pose_map_odom(StampNs stamp_ns, const Pose2& pose_map_base) const {
+  const auto odom_base = pose_odom_base(stamp_ns);
+  if (!odom_base) return std::nullopt;
+  return compose(pose_map_base, inverse(*odom_base));
+}
+
+}  // namespace beaconloc::bridge

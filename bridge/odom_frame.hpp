@@ -1,0 +1,45 @@
+#pragma once
+// The robot's pose in its odometry frame over the last seconds, so that the bridge can publish
+// map -> odom (REP-105) for a pose estimate: T_map_odom = T_map_base * T_odom_base^-1 at the
+// estimate's stamp. The odom -> base pose comes from the robot's driver (nav_msgs/Odometry) when
+// it feeds us, else from integrating the wheel odometry on the bus. DDS-free.
+#include <deque>
+#include <optional>
+
+#include "beaconloc/core/measurements.hpp"
+#include "beaconloc/core/pose2.hpp"
+
+namespace beaconloc::bridge {
+
+class OdomFrame {
+ public:
+  explicit OdomFrame(StampNs history_ns = 2'000'000'000) : history_ns_(history_ns) {}
+  // Integrates wheel velocities (eq. 14 of seed 000) from the previous sample; the first sample
+  // anchors the frame at the origin. Out-of-order samples are refused (false).
+  bool add_wheel_odometry(const OdometrySample& o);
+  // A driver's own odom -> base pose.
+  bool add_odom_pose(StampNs stamp_ns, const Pose2& pose_odom_base);
+  // odom -> base at stamp_ns, interpolated between neighbours; nullopt outside the history.
+  std::optional<Pose2> pose_odom_base(StampNs stamp_ns) const;
+  // map -> odom from a pose estimate stamped stamp_ns.
+  std::optional<Pose2> pose_map_odom(StampNs stamp_ns, const Pose2& pose_map_base) const;
+  // The newest stamp of the history, if any.
+  std::optional<StampNs> latest_stamp_ns() const {
+    return poses_.empty() ? std::nullopt : std::optional<StampNs>(poses_.back().first);
+  }
+  // The latest wheel odometry's twist (v, omega), for nav_msgs/Odometry.
+  double v_mps() const { return v_mps_; }
+  double omega_radps() const { return omega_radps_; }
+
+ private:
+  bool push(StampNs stamp_ns, const Pose2& pose);
+  StampNs history_ns_;
+  std::deque<std::pair<StampNs, Pose2>> poses_;
+  double v_mps_ = 0.0;
+  double omega_radps_ = 0.0;
+};
+
+// The inverse of a planar transform and composition live in core/pose2.hpp (compose).
+Pose2 inverse(const Pose2& t);
+
+}  // namespace beaconloc::bridge

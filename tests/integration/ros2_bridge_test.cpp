@@ -1,0 +1,224 @@
+// The ROS 2 bridge on the wire, Fast DDS on both sides: `beaconloc run --bridge` in its own
+// process, and readers in this one with the QoS ROS 2 tools use. Every output topic matches a
+// reader with rviz2's QoS and carries what it should; a reader that joins late gets the latched
+// topics (beacon_pose, tf_static, beacons) at once.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "beaconloc/core/csv_reader.hpp"
+#include "beaconloc/core/occupancy_grid_io.hpp"
+#include "beaconloc/dds/participant.hpp"
+#include "domain_id.hpp"
+#include "process.hpp"
+#include "ros2_convert.hpp"
+
+namespace beaconloc::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+const std::string kSource = BEACONLOC_SOURCE_DIR;
+
+template <class T>
+struct Inbox {
+  std::mutex mutex;
+  std::vector<T> samples;
+  void add(const T& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    samples.push_back(m);
+  }
+  std::size_t size() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return samples.size();
+  }
+  T last() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return samples.back();
+  }
+};
+
+// Waits until pred() holds or the timeout passes.
+template <class Pred>
+bool eventually(Pred pred, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (!pred()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(20ms);
+  }
+  return true;
+}
+
+TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) {
+  DomainLease domain;
+  char dir[] = "/tmp/beaconloc-bridge-XXXXXX";
+  ASSERT_NE(::mkdtemp(dir), nullptr);
+  ChildProcess run({BEACONLOC_EXECUTABLE, "run", "--bridge", "--speed", "1", "--duration-s", "14", "--out",
+                    dir, "--domain", std::to_string(domain.id())},
+                   std::string(dir) + "/run.log");
+
+  dds::DdsOptions options;
+  options.domain_id = domain.id();
+  options.extra_qos_files = {kSource + "/tests/integration/rviz2_readers.xml"};
+  Inbox<geometry_msgs::msg::PoseWithCovarianceStamped> poses;
+  Inbox<nav_msgs::msg::Odometry> odometry;
+  Inbox<tf2_msgs::msg::TFMessage> tf;
+  Inbox<visualization_msgs::msg::MarkerArray> beacons;
+  Inbox<sensor_msgs::msg::Range> ranges;
+  {
+    dds::Participant rviz(options, "test.rviz2");
+    rviz.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+        {"rt/beacon_pose", "", "rviz2.reader"}, [&](const auto& m) { poses.add(m); });
+    rviz.subscribe<nav_msgs::msg::OdometryPubSubType>({"rt/odometry/beacons", "", "rviz2.reader"},
+                                                      [&](const auto& m) { odometry.add(m); });
+    rviz.subscribe<tf2_msgs::msg::TFMessagePubSubType>({"rt/tf", "", "rviz2.reader"},
+                                                       [&](const auto& m) { tf.add(m); });
+    rviz.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>({"rt/beacons", "", "rviz2.reader"},
+                                                                   [&](const auto& m) { beacons.add(m); });
+    rviz.subscribe<sensor_msgs::msg::RangePubSubType>({"rt/beacon_ranges", "", "rviz2.reader"},
+                                                      [&](const auto& m) { ranges.add(m); });
+    // tf_static with rviz2's QoS too: it matches (the one message went out before we joined).
+    auto* tf_static_reader = rviz.subscribe<tf2_msgs::msg::TFMessagePubSubType>(
+        {"rt/tf_static", "", "rviz2.reader"}, [](const tf2_msgs::msg::TFMessage&) {});
+    EXPECT_TRUE(eventually(
+        [&] {
+          eprosima::fastdds::dds::SubscriptionMatchedStatus status;
+          tf_static_reader->get_subscription_matched_status(status);
+          return status.current_count > 0;
+        },
+        10s));
+    ASSERT_TRUE(eventually([&] { return poses.size() > 100 && tf.size() > 100 && ranges.size() > 10; }, 20s))
+        << "poses " << poses.size() << ", tf " << tf.size() << ", ranges " << ranges.size() << "\n"
+        << run.log();
+    EXPECT_GT(odometry.size(), 100u);
+
+    const auto pose = poses.last();
+    EXPECT_EQ(pose.header().frame_id(), "map");
+    EXPECT_GT(pose.pose().covariance()[0], 0.0);   // x
+    EXPECT_GT(pose.pose().covariance()[35], 0.0);  // yaw
+    EXPECT_EQ(pose.pose().covariance()[14], 0.0);  // z: unestimated
+    EXPECT_TRUE(bridge::planar_yaw(pose.pose().pose().orientation()));
+    const auto transforms = tf.last();
+    ASSERT_EQ(transforms.transforms().size(), 1u);
+    EXPECT_EQ(transforms.transforms()[0].header().frame_id(), "map");
+    EXPECT_EQ(transforms.transforms()[0].child_frame_id(), "odom");
+    const auto odom = odometry.last();
+    EXPECT_EQ(odom.child_frame_id(), "base_link");
+    EXPECT_GT(std::abs(odom.twist().twist().linear().x()), 0.1);  // the robot drives at 0.34 m/s
+    const auto range = ranges.last();
+    EXPECT_EQ(range.radiation_type(), bridge::kRangeUltrasound);
+    EXPECT_EQ(range.header().frame_id().rfind("receiver_", 0), 0u);
+    EXPECT_GT(range.range(), 1.5f);  // the ceiling is 2 m above the receivers
+
+    // rviz2's 2D Pose Estimate: the localizer restarts 1 m ahead of where it is.
+    const auto before = poses.last();
+    auto* writer = rviz.writer<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+        {"rt/initialpose", "test.initialpose.writer", ""});
+    geometry_msgs::msg::PoseWithCovarianceStamped reset = before;
+    reset.pose().pose().position().x(before.pose().pose().position().x() + 1.0);
+    const double wanted_x = reset.pose().pose().position().x();
+    ASSERT_TRUE(dds::wait_for_matched_readers({writer}, 5s));
+    writer->write(&reset);
+    EXPECT_TRUE(
+        eventually([&] { return std::abs(poses.last().pose().pose().position().x() - wanted_x) < 0.4; }, 5s))
+        << "last x " << poses.last().pose().pose().position().x() << ", wanted about " << wanted_x;
+    rviz.close();
+  }
+
+  // A late listener of the latched topics: the newest pose, the receiver frames, the beacons.
+  Inbox<geometry_msgs::msg::PoseWithCovarianceStamped> late_poses;
+  Inbox<tf2_msgs::msg::TFMessage> late_static;
+  Inbox<visualization_msgs::msg::MarkerArray> late_beacons;
+  dds::Participant late(options, "test.late");
+  late.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+      {"rt/beacon_pose", "", "late.reader"}, [&](const auto& m) { late_poses.add(m); });
+  late.subscribe<tf2_msgs::msg::TFMessagePubSubType>({"rt/tf_static", "", "late.reader"},
+                                                     [&](const auto& m) { late_static.add(m); });
+  late.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>({"rt/beacons", "", "late.reader"},
+                                                                 [&](const auto& m) { late_beacons.add(m); });
+  ASSERT_TRUE(eventually([&] { return late_poses.size() && late_static.size() && late_beacons.size(); }, 5s))
+      << late_poses.size() << " " << late_static.size() << " " << late_beacons.size();
+  const auto frames = late_static.last();
+  ASSERT_EQ(frames.transforms().size(), 3u);  // the three receivers of the built-in robot
+  EXPECT_EQ(frames.transforms()[0].header().frame_id(), "base_link");
+  EXPECT_EQ(frames.transforms()[2].child_frame_id(), "receiver_2");
+  EXPECT_NEAR(std::hypot(frames.transforms()[1].transform().translation().x(),
+                         frames.transforms()[1].transform().translation().y()),
+              0.19, 1e-9);
+  EXPECT_EQ(late_beacons.last().markers().size(), 12u);  // six beacons, a sphere and a label each
+  late.close();
+
+  run.signal(SIGTERM);
+  EXPECT_TRUE(run.wait(20s));
+  std::filesystem::remove_all(dir);
+}
+
+// A ROS 2 robot on Cyclone DDS (the DDS under rmw_cyclonedds in Humble and Jazzy) feeds the
+// bridge nav_msgs/Odometry on rt/odom (reliable) and LaserScan on rt/scan (best effort); the
+// localizer (the seed 001 UKF on the laser, the room's map as a map_server file) localizes it;
+// the Cyclone peer reads rt/beacon_pose, rt/tf and rt/beacons back and checks every field.
+// Both start orders.
+class CycloneRobot : public ::testing::TestWithParam<bool> {};
+
+TEST_P(CycloneRobot, FeedsTheBridgeAndReadsItsOutputsBack) {
+  const bool bridge_first = GetParam();
+  DomainLease domain;
+  char dir[] = "/tmp/beaconloc-cyclone-XXXXXX";
+  ASSERT_NE(::mkdtemp(dir), nullptr);
+  const std::string d = dir;
+  OccupancyGrid room({0.0, 0.0}, 0.1, 40, 30);  // walls' inner faces at 0.1 / 3.9 and 0.1 / 2.9 m
+  room.fill_border();
+  write_occupancy_grid(room, d + "/map.yaml");
+  write_beacon_map_csv(d + "/beacons.csv", BeaconMap({{1, {0.5, 0.5, 2.5}}, {2, {3.5, 2.5, 2.5}}}));
+  const std::string domain_id = std::to_string(domain.id());
+  auto start_pipeline = [&] {
+    std::vector<std::unique_ptr<ChildProcess>> p;
+    p.push_back(std::make_unique<ChildProcess>(
+        std::vector<std::string>{BEACONLOC_EXECUTABLE, "localizer", "--domain", domain_id, "--estimator",
+                                 "ukf_lrf_laser_only", "--map", d + "/map.yaml", "--initial-pose", "1.0",
+                                 "1.5", "0.0", "--receivers", "0:0"},
+        d + "/localizer.log"));
+    p.push_back(std::make_unique<ChildProcess>(
+        std::vector<std::string>{BEACONLOC_EXECUTABLE, "bridge", "--domain", domain_id,
+                                 "--participant-profile", "beaconloc.loopback_interop", "--odom-in",
+                                 "--scan-in", "--wheel-base-m", "0.4", "--beacons", d + "/beacons.csv",
+                                 "--receivers", "0:0"},
+        d + "/bridge.log"));
+    return p;
+  };
+  std::vector<std::unique_ptr<ChildProcess>> pipeline;
+  if (bridge_first) {
+    pipeline = start_pipeline();
+    std::this_thread::sleep_for(2s);
+  }
+  ChildProcess peer({CYCLONE_ROS2_PEER, "--domain", domain_id, "--seconds", "40", "--beacons",
+                     "1:0.5:0.5:2.5,2:3.5:2.5:2.5"},
+                    d + "/peer.log");
+  if (!bridge_first) {
+    std::this_thread::sleep_for(2s);
+    pipeline = start_pipeline();
+  }
+  const auto code = peer.wait(60s);
+  EXPECT_EQ(code, 0) << peer.log() << "\n--- bridge\n"
+                     << pipeline[1]->log() << "\n--- localizer\n"
+                     << pipeline[0]->log();
+  for (auto& p : pipeline) {
+    p->signal(SIGTERM);
+    EXPECT_EQ(p->wait(20s), 0) << p->log();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothStartOrders, CycloneRobot, ::testing::Values(true, false),
+                         [](const ::testing::TestParamInfo<bool>& order) {
+                           return std::string(order.param ? "BridgeFirst" : "RobotFirst");
+                         });
+
+}  // namespace
+}  // namespace beaconloc::testing

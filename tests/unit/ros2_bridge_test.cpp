@@ -1,0 +1,143 @@
+// The ROS 2 bridge's conversions and frame maths (no DDS traffic): REP-103/105 conventions, the
+// 3 x 3 covariance in the 6 x 6, a driver's twist as wheel speeds, map -> odom, and the type
+// names on the wire exactly as ROS 2 names them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "odom_frame.hpp"
+#include "ros2_convert.hpp"
+
+namespace beaconloc::bridge {
+namespace {
+
+TEST(Ros2Bridge, TypeNamesOnTheWireAreTheRos2Ones) {
+  EXPECT_EQ(geometry_msgs::msg::PoseWithCovarianceStampedPubSubType().getName(),
+            std::string("geometry_msgs::msg::dds_::PoseWithCovarianceStamped_"));
+  EXPECT_EQ(nav_msgs::msg::OdometryPubSubType().getName(), std::string("nav_msgs::msg::dds_::Odometry_"));
+  EXPECT_EQ(tf2_msgs::msg::TFMessagePubSubType().getName(), std::string("tf2_msgs::msg::dds_::TFMessage_"));
+  EXPECT_EQ(visualization_msgs::msg::MarkerArrayPubSubType().getName(),
+            std::string("visualization_msgs::msg::dds_::MarkerArray_"));
+  EXPECT_EQ(sensor_msgs::msg::LaserScanPubSubType().getName(),
+            std::string("sensor_msgs::msg::dds_::LaserScan_"));
+  EXPECT_EQ(sensor_msgs::msg::RangePubSubType().getName(), std::string("sensor_msgs::msg::dds_::Range_"));
+  // ROS topics are unkeyed: a keyed type would not match a ROS 2 endpoint.
+  EXPECT_FALSE(nav_msgs::msg::OdometryPubSubType().m_isGetKeyDefined);
+  EXPECT_FALSE(geometry_msgs::msg::PoseWithCovarianceStampedPubSubType().m_isGetKeyDefined);
+}
+
+TEST(Ros2Bridge, TimeAndOrientationFollowRep103) {
+  const auto t = to_ros_time(1'234'567'890'123);
+  EXPECT_EQ(t.sec(), 1234);
+  EXPECT_EQ(t.nanosec(), 567'890'123u);
+  EXPECT_EQ(from_ros_time(t), 1'234'567'890'123);
+  builtin_interfaces::msg::Time bad;
+  bad.nanosec(1'000'000'000u);
+  EXPECT_FALSE(from_ros_time(bad));
+  for (double yaw : {-3.0, -1.0, 0.0, 0.5, 2.9}) EXPECT_NEAR(*planar_yaw(yaw_to_quaternion(yaw)), yaw, 1e-12);
+  geometry_msgs::msg::Quaternion tilted;  // 90 degrees about x
+  tilted.x(std::sqrt(0.5));
+  tilted.w(std::sqrt(0.5));
+  EXPECT_FALSE(planar_yaw(tilted));
+  geometry_msgs::msg::Quaternion zero;  // not a rotation
+  EXPECT_FALSE(planar_yaw(zero));
+}
+
+TEST(Ros2Bridge, PoseCovarianceGoesToXYYawOfTheSixBySix) {
+  PoseEstimate e;
+  e.stamp_ns = 5'000'000'000;
+  e.pose_map_base = Pose2(1.5, -2.0, 0.7);
+  e.covariance << 0.04, 0.01, 0.002, 0.01, 0.09, 0.003, 0.002, 0.003, 0.0025;
+  const auto m = to_pose_with_covariance(e, "map");
+  EXPECT_EQ(m.header().frame_id(), "map");
+  EXPECT_EQ(m.header().stamp().sec(), 5);
+  EXPECT_EQ(m.pose().pose().position().x(), 1.5);
+  EXPECT_EQ(m.pose().pose().position().y(), -2.0);
+  EXPECT_NEAR(*planar_yaw(m.pose().pose().orientation()), 0.7, 1e-12);
+  const auto& c = m.pose().covariance();
+  EXPECT_EQ(c[0 * 6 + 0], 0.04);
+  EXPECT_EQ(c[0 * 6 + 1], 0.01);
+  EXPECT_EQ(c[0 * 6 + 5], 0.002);
+  EXPECT_EQ(c[1 * 6 + 1], 0.09);
+  EXPECT_EQ(c[5 * 6 + 5], 0.0025);
+  EXPECT_EQ(c[2 * 6 + 2], 0.0);  // z, roll, pitch unestimated, left 0 as amcl_pose does
+  EXPECT_EQ(planar_covariance(c.data()), e.covariance);
+  // An initialpose from rviz2 comes back as the same pose and covariance.
+  std::string why;
+  const auto init = from_initial_pose(m, &why);
+  ASSERT_TRUE(init) << why;
+  EXPECT_TRUE(init->pose_map_base.isApprox(e.pose_map_base, 1e-12));
+  EXPECT_EQ(init->covariance, e.covariance);
+}
+
+TEST(Ros2Bridge, DriverOdometryBecomesWheelSpeedsAndBadOnesAreRefused) {
+  nav_msgs::msg::Odometry m;
+  m.header().stamp(to_ros_time(2'000'000'000));
+  m.twist().twist().linear().x(0.5);
+  m.twist().twist().angular().z(0.2);
+  m.twist().covariance()[0] = 0.01;
+  m.twist().covariance()[35] = 0.04;
+  std::string why;
+  const auto o = from_ros_odometry(m, 0.4, &why);
+  ASSERT_TRUE(o) << why;
+  EXPECT_EQ(o->stamp_ns, 2'000'000'000);
+  EXPECT_NEAR(o->wheel_velocity_right_mps, 0.5 + 0.2 * 0.2, 1e-12);
+  EXPECT_NEAR(o->wheel_velocity_left_mps, 0.5 - 0.2 * 0.2, 1e-12);
+  // Back through the same map: v and omega's variances.
+  EXPECT_NEAR((o->wheel_velocity_covariance(0, 0) + o->wheel_velocity_covariance(1, 1) +
+               2 * o->wheel_velocity_covariance(0, 1)) /
+                  4.0,
+              0.01, 1e-12);
+  m.twist().twist().linear().x(std::nan(""));
+  EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
+  EXPECT_EQ(why, "non_finite_twist");
+  sensor_msgs::msg::LaserScan scan;
+  EXPECT_FALSE(from_ros_scan(scan, &why));
+  EXPECT_EQ(why, "no_beams");
+}
+
+TEST(Ros2Bridge, MapToOdomComposesToTheEstimate) {
+  OdomFrame odom;
+  OdometrySample o;
+  o.wheel_base_m = 0.4;
+  o.stamp_ns = 0;
+  ASSERT_TRUE(odom.add_wheel_odometry(o));  // anchor: odom -> base = identity at t = 0
+  o.wheel_velocity_right_mps = 0.6;
+  o.wheel_velocity_left_mps = 0.4;
+  for (int k = 1; k <= 100; ++k) {
+    o.stamp_ns = k * 10'000'000;
+    ASSERT_TRUE(odom.add_wheel_odometry(o));
+  }
+  EXPECT_FALSE(odom.add_wheel_odometry(o));  // same stamp again: refused
+  const Pose2 map_base(3.0, 1.0, 0.4);
+  const auto map_odom = odom.pose_map_odom(1'000'000'000, map_base);
+  ASSERT_TRUE(map_odom);
+  // map -> odom composed with odom -> base gives the estimate back.
+  const Pose2 back = compose(*map_odom, *odom.pose_odom_base(1'000'000'000));
+  EXPECT_TRUE(back.isApprox(map_base, 1e-12)) << back.transpose();
+  EXPECT_NEAR(odom.v_mps(), 0.5, 1e-12);
+  EXPECT_NEAR(odom.omega_radps(), 0.5, 1e-12);
+  // Between two samples: interpolated; outside the history: none.
+  EXPECT_TRUE(odom.pose_odom_base(995'000'000));
+  EXPECT_FALSE(odom.pose_odom_base(2'000'000'000));
+}
+
+TEST(Ros2Bridge, BeaconMarkersAndRanges) {
+  const BeaconMap map({{1, {0.0, 0.0, 2.0}}, {7, {3.0, 1.0, 2.5}}});
+  const auto markers = beacon_markers(map, "map", 0);
+  ASSERT_EQ(markers.markers().size(), 4u);  // a sphere and an id text per beacon
+  EXPECT_EQ(markers.markers()[2].id(), 7);
+  EXPECT_EQ(markers.markers()[2].pose().position().z(), 2.5);
+  EXPECT_EQ(markers.markers()[3].text(), "7");
+  RangeMeasurement r;
+  r.stamp_ns = 1;
+  r.range_m = 2.25;
+  r.variance_m2 = 1e-4;
+  const auto range = to_ros_range(r, "receiver_0", 2.0f, 0.0f, 15.0f);
+  EXPECT_EQ(range.radiation_type(), kRangeUltrasound);
+  EXPECT_EQ(range.range(), 2.25f);
+  EXPECT_EQ(range.header().frame_id(), "receiver_0");
+}
+
+}  // namespace
+}  // namespace beaconloc::bridge
