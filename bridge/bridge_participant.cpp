@@ -2,6 +2,9 @@
 
 #include <beaconlocPubSubTypes.h>
 
+#include <cctype>
+#include <stdexcept>
+
 #include "beaconloc/dds/convert.hpp"
 #include "beaconloc/dds/topics.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
@@ -13,6 +16,30 @@ std::string ros_topic(const std::string& ns, const std::string& name) {
   return ns.empty() ? "rt/" + name : "rt/" + ns + "/" + name;
 }
 
+namespace {
+
+// A ROS 2 namespace as the bridge takes it: tokens of [A-Za-z0-9_] not starting with a digit,
+// joined by '/', without leading or trailing '/' (ROS 2 name rules).
+void check_namespace(const std::string& ns) {
+  if (ns.empty()) return;
+  bool token_start = true;
+  for (char c : ns) {
+    if (c == '/') {
+      if (token_start) throw std::invalid_argument("bad ROS 2 namespace '" + ns + "': empty token");
+      token_start = true;
+      continue;
+    }
+    const bool ok = std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+    if (!ok || (token_start && std::isdigit(static_cast<unsigned char>(c)))) {
+      throw std::invalid_argument("bad ROS 2 namespace '" + ns + "' (write it without a leading '/')");
+    }
+    token_start = false;
+  }
+  if (token_start) throw std::invalid_argument("bad ROS 2 namespace '" + ns + "': ends with '/'");
+}
+
+}  // namespace
+
 BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions options)
     : options_(std::move(options)),
       beacon_pose_topic_(ros_topic(options_.ros_namespace, "beacon_pose")),
@@ -22,7 +49,7 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
       odom_in_topic_(ros_topic(options_.ros_namespace, "odom")),
       scan_in_topic_(ros_topic(options_.ros_namespace, "scan")),
       initial_pose_topic_(ros_topic(options_.ros_namespace, "initialpose")),
-      participant_(dds, "beaconloc.bridge." + options_.robot_id) {
+      participant_((check_namespace(options_.ros_namespace), dds), "beaconloc.bridge." + options_.robot_id) {
   using geometry_msgs::msg::PoseWithCovarianceStampedPubSubType;
   beacon_pose_writer_ = participant_.writer<PoseWithCovarianceStampedPubSubType>(
       {beacon_pose_topic_.c_str(), "ros2.beacon_pose.writer", ""});
@@ -89,6 +116,10 @@ void BridgeParticipant::on_pose(const msg::PoseEstimate& m) {
   if (m.robot_id() != options_.robot_id) return;
   const PoseEstimate e = dds::from_msg(m);
   std::lock_guard<std::mutex> lock(mutex_);
+  if (e.status == PoseStatus::kInitializing || e.status == PoseStatus::kLost) {
+    counts_.reject("pose.not_localized");  // as amcl: no pose, no map -> odom until localized
+    return;
+  }
   auto pose = to_pose_with_covariance(e, options_.map_frame);
   beacon_pose_writer_->write(&pose);
   auto odometry =
@@ -110,6 +141,13 @@ void BridgeParticipant::publish_pending_transforms() {
     if (const auto map_odom = odom_.pose_map_odom(e.stamp_ns, e.pose_map_base)) {
       tf2_msgs::msg::TFMessage tf;
       tf.transforms().push_back(to_transform(e.stamp_ns, *map_odom, options_.map_frame, options_.odom_frame));
+      // Without a driver (--odom-in), nobody else publishes odom -> base_link: the odometry the
+      // bridge integrates is the odom frame, and the tree map -> odom -> base_link -> receiver_i
+      // must be whole for rviz2.
+      if (!options_.odometry_in) {
+        tf.transforms().push_back(to_transform(e.stamp_ns, *odom_.pose_odom_base(e.stamp_ns),
+                                               options_.odom_frame, options_.base_frame));
+      }
       tf_writer_->write(&tf);
       counts_.accept();
     } else {
@@ -154,7 +192,8 @@ void BridgeParticipant::on_ros_odometry(const nav_msgs::msg::Odometry& m) {
   }
   const auto yaw = planar_yaw(m.pose().pose().orientation());
   if (!yaw || !odom_.add_odom_pose(
-                  o->stamp_ns, Pose2(m.pose().pose().position().x(), m.pose().pose().position().y(), *yaw))) {
+                  o->stamp_ns, Pose2(m.pose().pose().position().x(), m.pose().pose().position().y(), *yaw),
+                  m.twist().twist().linear().x(), m.twist().twist().angular().z())) {
     counts_.reject("odom.bad_or_out_of_order_pose");
     return;
   }

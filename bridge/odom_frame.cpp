@@ -36,8 +36,11 @@ bool OdomFrame::add_wheel_odometry(const OdometrySample& o) {
   return push(o.stamp_ns, pose);
 }
 
-bool OdomFrame::add_odom_pose(StampNs stamp_ns, const Pose2& pose) {
-  return pose.allFinite() && push(stamp_ns, pose);
+bool OdomFrame::add_odom_pose(StampNs stamp_ns, const Pose2& pose, double v_mps, double omega_radps) {
+  if (!pose.allFinite() || !push(stamp_ns, pose)) return false;
+  v_mps_ = v_mps;
+  omega_radps_ = omega_radps;
+  return true;
 }
 
 std::optional<Pose2> OdomFrame::pose_odom_base(StampNs stamp_ns) const {

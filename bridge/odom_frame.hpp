@@ -17,8 +17,8 @@ class OdomFrame {
   // Integrates wheel velocities (eq. 14 of seed 000) from the previous sample; the first sample
   // anchors the frame at the origin. Out-of-order samples are refused (false).
   bool add_wheel_odometry(const OdometrySample& o);
-  // A driver's own odom -> base pose.
-  bool add_odom_pose(StampNs stamp_ns, const Pose2& pose_odom_base);
+  // A driver's own odom -> base pose, and its twist.
+  bool add_odom_pose(StampNs stamp_ns, const Pose2& pose_odom_base, double v_mps, double omega_radps);
   // odom -> base at stamp_ns, interpolated between neighbours; nullopt outside the history.
   std::optional<Pose2> pose_odom_base(StampNs stamp_ns) const;
   // map -> odom from a pose estimate stamped stamp_ns.

@@ -28,7 +28,8 @@ builtin_interfaces::msg::Time to_ros_time(StampNs stamp_ns) {
 }
 
 std::optional<StampNs> from_ros_time(const builtin_interfaces::msg::Time& t) {
-  if (t.sec() < 0 || t.nanosec() >= 1'000'000'000u) return std::nullopt;
+  // Zero is ROS's "no stamp": a measurement without a time cannot be fused.
+  if (t.sec() < 0 || t.nanosec() >= 1'000'000'000u || (t.sec() == 0 && t.nanosec() == 0)) return std::nullopt;
   return static_cast<StampNs>(t.sec()) * 1'000'000'000 + static_cast<StampNs>(t.nanosec());
 }
 
@@ -130,8 +131,13 @@ std::optional<LaserScanSample> from_ros_scan(const sensor_msgs::msg::LaserScan& 
   if (!stamp) return fail("bad_stamp");
   if (m.ranges().empty()) return fail("no_beams");
   if (!std::isfinite(m.angle_min()) || !std::isfinite(m.angle_increment()) || !std::isfinite(m.range_min()) ||
-      !std::isfinite(m.range_max()) || !(m.range_max() > m.range_min())) {
+      !std::isfinite(m.range_max()) || !(m.range_max() > m.range_min()) || m.angle_increment() == 0.0f) {
     return fail("bad_scan_geometry");
+  }
+  // angle_max must be where the beams end (REP-117 scans carry both).
+  const double last = m.angle_min() + static_cast<double>(m.ranges().size() - 1) * m.angle_increment();
+  if (!std::isfinite(m.angle_max()) || std::abs(last - m.angle_max()) > std::abs(m.angle_increment())) {
+    return fail("angles_do_not_match_the_beams");
   }
   LaserScanSample s;
   s.stamp_ns = *stamp;
@@ -173,8 +179,15 @@ geometry_msgs::msg::TransformStamped to_transform(StampNs stamp_ns, const Pose2&
 
 visualization_msgs::msg::MarkerArray beacon_markers(const BeaconMap& map, const std::string& map_frame,
                                                     StampNs stamp_ns) {
-  constexpr std::int32_t kSphere = 2, kText = 9, kAdd = 0;
+  constexpr std::int32_t kSphere = 2, kText = 9, kAdd = 0, kDeleteAll = 3;
   visualization_msgs::msg::MarkerArray out;
+  // First clear what an earlier map drew: a beacon taken out of the map must leave the screen.
+  visualization_msgs::msg::Marker clear;
+  clear.header().stamp(to_ros_time(stamp_ns));
+  clear.header().frame_id(map_frame);
+  clear.action(kDeleteAll);
+  clear.pose().orientation().w(1.0);
+  out.markers().push_back(clear);
   for (const Beacon& b : map.beacons()) {
     for (const bool text : {false, true}) {
       visualization_msgs::msg::Marker m;

@@ -79,20 +79,24 @@ TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) 
                                                       [&](const auto& m) { odometry.add(m); });
     rviz.subscribe<tf2_msgs::msg::TFMessagePubSubType>({"rt/tf", "", "rviz2.reader"},
                                                        [&](const auto& m) { tf.add(m); });
-    rviz.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>({"rt/beacons", "", "rviz2.reader"},
-                                                                   [&](const auto& m) { beacons.add(m); });
+    auto* beacons_reader = rviz.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>(
+        {"rt/beacons", "", "rviz2.reader"}, [&](const auto& m) { beacons.add(m); });
     rviz.subscribe<sensor_msgs::msg::RangePubSubType>({"rt/beacon_ranges", "", "rviz2.reader"},
                                                       [&](const auto& m) { ranges.add(m); });
     // tf_static with rviz2's QoS too: it matches (the one message went out before we joined).
     auto* tf_static_reader = rviz.subscribe<tf2_msgs::msg::TFMessagePubSubType>(
         {"rt/tf_static", "", "rviz2.reader"}, [](const tf2_msgs::msg::TFMessage&) {});
-    EXPECT_TRUE(eventually(
-        [&] {
-          eprosima::fastdds::dds::SubscriptionMatchedStatus status;
-          tf_static_reader->get_subscription_matched_status(status);
-          return status.current_count > 0;
-        },
-        10s));
+    auto matched = [&](eprosima::fastdds::dds::DataReader* reader) {
+      return eventually(
+          [&] {
+            eprosima::fastdds::dds::SubscriptionMatchedStatus status;
+            reader->get_subscription_matched_status(status);
+            return status.current_count > 0;
+          },
+          10s);
+    };
+    EXPECT_TRUE(matched(tf_static_reader));
+    EXPECT_TRUE(matched(beacons_reader));  // its one message may have gone out before we joined
     ASSERT_TRUE(eventually([&] { return poses.size() > 100 && tf.size() > 100 && ranges.size() > 10; }, 20s))
         << "poses " << poses.size() << ", tf " << tf.size() << ", ranges " << ranges.size() << "\n"
         << run.log();
@@ -104,10 +108,34 @@ TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) 
     EXPECT_GT(pose.pose().covariance()[35], 0.0);  // yaw
     EXPECT_EQ(pose.pose().covariance()[14], 0.0);  // z: unestimated
     EXPECT_TRUE(bridge::planar_yaw(pose.pose().pose().orientation()));
+    // map -> odom and, as no driver publishes it, odom -> base_link; composed, they are the pose.
     const auto transforms = tf.last();
-    ASSERT_EQ(transforms.transforms().size(), 1u);
+    ASSERT_EQ(transforms.transforms().size(), 2u);
     EXPECT_EQ(transforms.transforms()[0].header().frame_id(), "map");
     EXPECT_EQ(transforms.transforms()[0].child_frame_id(), "odom");
+    EXPECT_EQ(transforms.transforms()[1].header().frame_id(), "odom");
+    EXPECT_EQ(transforms.transforms()[1].child_frame_id(), "base_link");
+    auto planar = [](const geometry_msgs::msg::Transform& t) {
+      return Pose2(t.translation().x(), t.translation().y(), *bridge::planar_yaw(t.rotation()));
+    };
+    const Pose2 map_base = compose(planar(transforms.transforms()[0].transform()),
+                                   planar(transforms.transforms()[1].transform()));
+    bool matched_a_pose = false;
+    {
+      std::lock_guard<std::mutex> lock(poses.mutex);
+      for (const auto& p : poses.samples) {
+        if (p.header().stamp().sec() != transforms.transforms()[0].header().stamp().sec() ||
+            p.header().stamp().nanosec() != transforms.transforms()[0].header().stamp().nanosec()) {
+          continue;
+        }
+        matched_a_pose = true;
+        EXPECT_NEAR(map_base.x(), p.pose().pose().position().x(), 1e-9);
+        EXPECT_NEAR(map_base.y(), p.pose().pose().position().y(), 1e-9);
+        EXPECT_NEAR(wrap_angle_rad(map_base.z() - *bridge::planar_yaw(p.pose().pose().orientation())), 0.0,
+                    1e-9);
+      }
+    }
+    EXPECT_TRUE(matched_a_pose);
     const auto odom = odometry.last();
     EXPECT_EQ(odom.child_frame_id(), "base_link");
     EXPECT_GT(std::abs(odom.twist().twist().linear().x()), 0.1);  // the robot drives at 0.34 m/s
@@ -151,7 +179,7 @@ TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) 
   EXPECT_NEAR(std::hypot(frames.transforms()[1].transform().translation().x(),
                          frames.transforms()[1].transform().translation().y()),
               0.19, 1e-9);
-  EXPECT_EQ(late_beacons.last().markers().size(), 12u);  // six beacons, a sphere and a label each
+  EXPECT_EQ(late_beacons.last().markers().size(), 13u);  // clear all, then six beacons' sphere and label
   late.close();
 
   run.signal(SIGTERM);

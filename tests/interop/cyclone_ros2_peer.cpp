@@ -4,9 +4,10 @@
 // 2.9 m), publishing what a robot's drivers publish:
 //   rt/odom  nav_msgs/Odometry, reliable (odom -> base_link: its true pose), 50 Hz;
 //   rt/scan  sensor_msgs/LaserScan, best effort (sensor-data QoS), 19 beams, 25 Hz;
-// and reads what rviz2 would: rt/beacon_pose, rt/tf (reliable, volatile) and rt/beacons
-// (reliable, transient local), checking every field it can know. Exit 0 once all checks have
-// passed, 1 with the failures on stderr when --seconds run out.
+// and reads what rviz2 and tf2 would: rt/beacon_pose, rt/tf, rt/odometry/beacons (reliable,
+// volatile), rt/beacons and rt/tf_static (reliable, transient local), checking every field it can
+// know. Exit 0 once every topic has delivered a correct sample; 1, with the failures on stderr,
+// at the first wrong field or when --seconds run out.
 //   cyclone_ros2_peer --domain N --seconds S --beacons ID:X:Y:Z[,ID:X:Y:Z...]
 #include <dds/dds.h>
 
@@ -112,9 +113,14 @@ int main(int argc, char** argv) {
       nullptr);
   const dds_entity_t tf_reader =
       dds_create_reader(participant, topic(&tf2_msgs_msg_dds__TFMessage__desc, "rt/tf"), rviz_qos, nullptr);
+  const dds_entity_t odometry_reader = dds_create_reader(
+      participant, topic(&nav_msgs_msg_dds__Odometry__desc, "rt/odometry/beacons"), rviz_qos, nullptr);
+  const dds_entity_t tf_static_reader = dds_create_reader(
+      participant, topic(&tf2_msgs_msg_dds__TFMessage__desc, "rt/tf_static"), latched_qos, nullptr);
   const dds_entity_t beacons_reader = dds_create_reader(
       participant, topic(&visualization_msgs_msg_dds__MarkerArray__desc, "rt/beacons"), latched_qos, nullptr);
-  if (odom_writer < 0 || scan_writer < 0 || pose_reader < 0 || tf_reader < 0 || beacons_reader < 0) {
+  if (odom_writer < 0 || scan_writer < 0 || pose_reader < 0 || tf_reader < 0 || beacons_reader < 0 ||
+      odometry_reader < 0 || tf_static_reader < 0) {
     std::fprintf(stderr, "creating the endpoints failed\n");
     return 2;
   }
@@ -130,7 +136,8 @@ int main(int argc, char** argv) {
   const double v = 0.3, x0 = 1.0, y0 = 1.5;
   double drive_from_s = 1e9;
   auto truth_x = [&](double t) { return std::min(x0 + v * std::max(0.0, t - drive_from_s), 3.0); };
-  bool pose_ok = false, tf_ok = false, beacons_ok = false;
+  bool pose_ok = false, tf_ok = false, beacons_ok = false, odometry_ok = false, tf_static_ok = false;
+  int pose_samples = 0, tf_samples = 0;
   Checks last;
   std::vector<float> ranges(kBeams);
   for (long long step = 0;; ++step) {
@@ -209,6 +216,7 @@ int main(int argc, char** argv) {
       c.expect(p->header.stamp.nanosec < 1000000000u, "beacon_pose stamp nanosec");
       if (c.failures.empty() && true_x_then > x0 + 0.5) pose_ok = true;  // tracked while driving
       last.failures.insert(last.failures.end(), c.failures.begin(), c.failures.end());
+      ++pose_samples;
     }
     if (n > 0) dds_return_loan(pose_reader, samples, n);
     n = dds_take(tf_reader, samples, infos, 8, 8);
@@ -232,6 +240,7 @@ int main(int argc, char** argv) {
       }
       if (c.failures.empty()) tf_ok = true;
       last.failures.insert(last.failures.end(), c.failures.begin(), c.failures.end());
+      ++tf_samples;
     }
     if (n > 0) dds_return_loan(tf_reader, samples, n);
     n = dds_take(beacons_reader, samples, infos, 8, 8);
@@ -239,11 +248,15 @@ int main(int argc, char** argv) {
       if (!infos[i].valid_data) continue;
       const auto* m = static_cast<visualization_msgs_msg_dds__MarkerArray_*>(samples[i]);
       Checks c;
-      c.expect(m->markers._length == 2 * beacons.size(), "beacons: a sphere and a label per beacon");
-      for (uint32_t k = 0; k < m->markers._length && k / 2 < beacons.size(); ++k) {
+      c.expect(m->markers._length == 1 + 2 * beacons.size(),
+               "beacons: clear all, then a sphere and a label each");
+      c.expect(m->markers._length > 0 && m->markers._buffer[0].action == 3 &&
+                   std::strcmp(m->markers._buffer[0].header.frame_id, "map") == 0,
+               "beacons: DELETEALL first");
+      for (uint32_t k = 1; k < m->markers._length && (k - 1) / 2 < beacons.size(); ++k) {
         const auto& mk = m->markers._buffer[k];
-        const Beacon& b = beacons[k / 2];
-        const bool label = k % 2 == 1;
+        const Beacon& b = beacons[(k - 1) / 2];
+        const bool label = (k - 1) % 2 == 1;
         c.expect(std::strcmp(mk.header.frame_id, "map") == 0, "marker frame");
         c.expect(mk.id == b.id, "marker id");
         c.expect(mk.type == (label ? 9 : 2) && mk.action == 0, "marker type and action");
@@ -269,14 +282,55 @@ int main(int argc, char** argv) {
       last.failures.insert(last.failures.end(), c.failures.begin(), c.failures.end());
     }
     if (n > 0) dds_return_loan(beacons_reader, samples, n);
-    if (pose_ok && tf_ok && beacons_ok) {
-      std::printf("cyclone peer: beacon_pose, tf and beacons received and checked after %.1f s\n", t);
+    n = dds_take(odometry_reader, samples, infos, 8, 8);
+    for (int i = 0; i < n; ++i) {
+      if (!infos[i].valid_data) continue;
+      const auto* o = static_cast<nav_msgs_msg_dds__Odometry_*>(samples[i]);
+      Checks c;
+      c.expect(
+          std::strcmp(o->header.frame_id, "map") == 0 && std::strcmp(o->child_frame_id, "base_link") == 0,
+          "odometry/beacons frames");
+      c.expect(std::abs(o->pose.pose.position.y - y0) < 0.1, "odometry/beacons pose");
+      c.expect(o->twist.twist.linear.x == 0.0 || std::abs(o->twist.twist.linear.x - v) < 1e-9,
+               "odometry/beacons twist: the driver's");
+      c.expect(o->twist.twist.linear.y == 0.0 && o->twist.twist.angular.z == 0.0,
+               "odometry/beacons twist, planar");
+      if (c.failures.empty() && o->twist.twist.linear.x > 0.0) odometry_ok = true;
+      last.failures.insert(last.failures.end(), c.failures.begin(), c.failures.end());
+    }
+    if (n > 0) dds_return_loan(odometry_reader, samples, n);
+    n = dds_take(tf_static_reader, samples, infos, 8, 8);
+    for (int i = 0; i < n; ++i) {
+      if (!infos[i].valid_data) continue;
+      const auto* m = static_cast<tf2_msgs_msg_dds__TFMessage_*>(samples[i]);
+      Checks c;
+      c.expect(m->transforms._length == 1, "tf_static: one receiver");
+      if (m->transforms._length == 1) {
+        const auto& tr = m->transforms._buffer[0];
+        c.expect(std::strcmp(tr.header.frame_id, "base_link") == 0 &&
+                     std::strcmp(tr.child_frame_id, "receiver_0") == 0,
+                 "tf_static frames");
+        c.expect(tr.transform.translation.x == 0.0 && tr.transform.translation.y == 0.0 &&
+                     tr.transform.rotation.w == 1.0,
+                 "tf_static: the receiver at the base's centre");
+      }
+      if (c.failures.empty()) tf_static_ok = true;
+      last.failures.insert(last.failures.end(), c.failures.begin(), c.failures.end());
+    }
+    if (n > 0) dds_return_loan(tf_static_reader, samples, n);
+    if (!last.failures.empty()) break;  // any sample with a wrong field fails the run
+    if (pose_ok && tf_ok && beacons_ok && odometry_ok && tf_static_ok) {
+      std::printf(
+          "cyclone peer: %d beacon_pose and %d tf samples, beacons, odometry/beacons and tf_static "
+          "received and checked after %.1f s\n",
+          pose_samples, tf_samples, t);
       dds_delete(participant);
       return 0;
     }
     std::this_thread::sleep_until(start + std::chrono::milliseconds(20 * (step + 1)));
   }
-  std::fprintf(stderr, "cyclone peer: pose %d, tf %d, beacons %d; failures:\n", pose_ok, tf_ok, beacons_ok);
+  std::fprintf(stderr, "cyclone peer: pose %d, tf %d, beacons %d, odometry %d, tf_static %d; failures:\n",
+               pose_ok, tf_ok, beacons_ok, odometry_ok, tf_static_ok);
   for (std::size_t i = 0; i < last.failures.size() && i < 20; ++i)
     std::fprintf(stderr, "  %s\n", last.failures[i].c_str());
   dds_delete(participant);

@@ -72,9 +72,32 @@ TEST(Ekf, JosephFormKeepsCovarianceSymmetricPositiveDefinite) {
     ekf.update<1>(Eigen::Matrix<double, 1, 1>(0.0), h, Eigen::Matrix<double, 1, 1>(1e-8), 1e12);
   }
   const Eigen::Matrix3d p = ekf.covariance();
-  EXPECT_TRUE(p.isApprox(p.transpose(), 0.0) || (p - p.transpose()).norm() < 1e-15);
+  EXPECT_EQ(p, p.transpose());  // exactly: consumers (ROS 2 tools) check symmetry
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(p);
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
+}
+
+// P = F P F^T + Q rounds to a slightly asymmetric matrix; the filter must hand out an exactly
+// symmetric one. (An in-place `p = 0.5 * (p + p.transpose())` does not: Eigen's transpose
+// aliasing made it asymmetric by up to the off-diagonal difference.)
+TEST(Ekf, PredictedAndUpdatedCovariancesAreExactlySymmetric) {
+  Eigen::Matrix3d m;
+  m << 1, 2, 3, 4, 5, 6, 7, 8, 9;
+  EXPECT_EQ(symmetrized(m), symmetrized(m).transpose());
+  EXPECT_EQ(symmetrized(m)(0, 2), 5.0);
+  Ekf<3> ekf;
+  Eigen::Matrix3d p0;
+  p0 << 0.3, 0.1, 0.05, 0.1, 0.2, 0.02, 0.05, 0.02, 0.1;
+  ekf.reset(Eigen::Vector3d::Zero(), p0);
+  Eigen::Matrix3d f;
+  f << 1.0, 0.01, 0.37, 0.0, 1.0, -0.29, 0.013, 0.0, 1.0;
+  for (int i = 0; i < 100; ++i) {
+    ekf.predict(Eigen::Vector3d::Zero(), f, 1e-3 * Eigen::Matrix3d::Identity());
+    ASSERT_EQ(ekf.covariance(), ekf.covariance().transpose()) << i;
+    ekf.update<1>(Eigen::Matrix<double, 1, 1>(0.01), Eigen::Matrix<double, 1, 3>(0.3, -0.7, 0.2),
+                  Eigen::Matrix<double, 1, 1>(0.01), 1e12);
+    ASSERT_EQ(ekf.covariance(), ekf.covariance().transpose()) << i;
+  }
 }
 
 }  // namespace

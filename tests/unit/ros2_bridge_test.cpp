@@ -93,7 +93,19 @@ TEST(Ros2Bridge, DriverOdometryBecomesWheelSpeedsAndBadOnesAreRefused) {
   EXPECT_EQ(why, "non_finite_twist");
   sensor_msgs::msg::LaserScan scan;
   EXPECT_FALSE(from_ros_scan(scan, &why));
+  EXPECT_EQ(why, "bad_stamp");  // zero: ROS's "no stamp"
+  scan.header().stamp(to_ros_time(3'000'000'000));
+  EXPECT_FALSE(from_ros_scan(scan, &why));
   EXPECT_EQ(why, "no_beams");
+  scan.ranges({1.0f, 2.0f, 3.0f});
+  scan.angle_min(-0.5f);
+  scan.angle_increment(0.5f);
+  scan.angle_max(0.5f);
+  scan.range_max(10.0f);
+  ASSERT_TRUE(from_ros_scan(scan, &why)) << why;
+  scan.angle_max(2.0f);  // says five beams, carries three
+  EXPECT_FALSE(from_ros_scan(scan, &why));
+  EXPECT_EQ(why, "angles_do_not_match_the_beams");
 }
 
 TEST(Ros2Bridge, MapToOdomComposesToTheEstimate) {
@@ -117,18 +129,21 @@ TEST(Ros2Bridge, MapToOdomComposesToTheEstimate) {
   EXPECT_TRUE(back.isApprox(map_base, 1e-12)) << back.transpose();
   EXPECT_NEAR(odom.v_mps(), 0.5, 1e-12);
   EXPECT_NEAR(odom.omega_radps(), 0.5, 1e-12);
-  // Between two samples: interpolated; outside the history: none.
-  EXPECT_TRUE(odom.pose_odom_base(995'000'000));
+  // Between two samples: interpolated (half way between the 0.99 s and 1.00 s poses).
+  const Pose2 a = *odom.pose_odom_base(990'000'000), b = *odom.pose_odom_base(1'000'000'000);
+  EXPECT_TRUE(odom.pose_odom_base(995'000'000)->isApprox(0.5 * (a + b), 1e-12));
+  // Outside the history: none.
   EXPECT_FALSE(odom.pose_odom_base(2'000'000'000));
 }
 
 TEST(Ros2Bridge, BeaconMarkersAndRanges) {
   const BeaconMap map({{1, {0.0, 0.0, 2.0}}, {7, {3.0, 1.0, 2.5}}});
   const auto markers = beacon_markers(map, "map", 0);
-  ASSERT_EQ(markers.markers().size(), 4u);  // a sphere and an id text per beacon
-  EXPECT_EQ(markers.markers()[2].id(), 7);
-  EXPECT_EQ(markers.markers()[2].pose().position().z(), 2.5);
-  EXPECT_EQ(markers.markers()[3].text(), "7");
+  ASSERT_EQ(markers.markers().size(), 5u);      // clear all, then a sphere and an id text per beacon
+  EXPECT_EQ(markers.markers()[0].action(), 3);  // DELETEALL: a removed beacon leaves the screen
+  EXPECT_EQ(markers.markers()[3].id(), 7);
+  EXPECT_EQ(markers.markers()[3].pose().position().z(), 2.5);
+  EXPECT_EQ(markers.markers()[4].text(), "7");
   RangeMeasurement r;
   r.stamp_ns = 1;
   r.range_m = 2.25;

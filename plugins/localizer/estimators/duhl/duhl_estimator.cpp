@@ -117,7 +117,7 @@ InputResult Duhl::update(const RangeMeasurement& r) {
     // Not in the paper: an estimate its own measurement contradicts (at 1.02 m/s a turn can
     // carry q^i far from the truth within one firing cycle) is discarded as eq. 31-32 would
     // discard an uncertain one, then initialized anew below. Without this, trajectory 4 lost
-    // track on 6 of 10 seeds (E_p RMS 0.24-1.66 m on those).
+    // track on 6 of 10 seeds (E_p RMS 0.24-1.29 m on those).
     const double innovation_m = r.range_m - it->second.q(r.receiver_id);
     const double variance_m2 = it->second.covariance(r.receiver_id, r.receiver_id) + r.variance_m2;
     if (innovation_m * innovation_m > params_.distance_innovation_gate * variance_m2) {

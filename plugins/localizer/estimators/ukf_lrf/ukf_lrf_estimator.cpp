@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "beaconloc/core/estimator_registry.hpp"
+#include "beaconloc/core/filters/symmetric.hpp"
 #include "beaconloc/core/models/range_model.hpp"
 #include "beaconloc/core/models/velocity_motion.hpp"
 
@@ -247,7 +248,7 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
   Eigen::MatrixXd x_centred = chi_x.colwise() - Eigen::Vector3d(prior);
   for (Eigen::Index i = 0; i < n_sigma; ++i) x_centred(2, i) = wrap_angle_rad(x_centred(2, i));
   Cov3 prior_cov = weighted_cross_covariance(x_centred, x_centred, w);
-  prior_cov = 0.5 * (prior_cov + prior_cov.transpose());
+  prior_cov = symmetrized(prior_cov);
   if (motion) {
     mean_ = prior;
     covariance_ = prior_cov;
@@ -317,7 +318,7 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
   Pose2 posterior = prior + k_gain * (z_measured - z_mean);  // eq. 21
   posterior.z() = wrap_angle_rad(posterior.z());
   Cov3 posterior_cov = prior_cov - k_gain * s * k_gain.transpose();  // eq. 22
-  posterior_cov = 0.5 * (posterior_cov + posterior_cov.transpose());
+  posterior_cov = symmetrized(posterior_cov);
   if (Eigen::LLT<Cov3>(posterior_cov).info() != Eigen::Success)
     return InputResult::rejected("covariance_not_positive_definite");
   mean_ = posterior;

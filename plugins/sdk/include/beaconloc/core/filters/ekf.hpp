@@ -5,6 +5,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include "beaconloc/core/filters/symmetric.hpp"
+
 namespace beaconloc {
 
 enum class UpdateOutcome {
@@ -36,7 +38,7 @@ class Ekf {
   void predict(const State& x_predicted, const Covariance& f, const Covariance& q) {
     x_ = x_predicted;
     p_ = f * p_ * f.transpose() + q;
-    p_ = 0.5 * (p_ + p_.transpose());
+    p_ = symmetrized(p_);
   }
 
   // innovation = z - h(x) (angle components wrapped by the caller), Jacobian H, noise R.
@@ -61,7 +63,7 @@ class Ekf {
     x_ += k * innovation;
     const Covariance i_kh = Covariance::Identity() - k * h;
     p_ = i_kh * p_ * i_kh.transpose() + k * r * k.transpose();
-    p_ = 0.5 * (p_ + p_.transpose());
+    p_ = symmetrized(p_);
     return result;
   }
 
