@@ -38,10 +38,15 @@ void check_namespace(const std::string& ns) {
   if (token_start) throw std::invalid_argument("bad ROS 2 namespace '" + ns + "': ends with '/'");
 }
 
+BridgeOptions validated(BridgeOptions o) {
+  check_namespace(o.ros_namespace);
+  return o;
+}
+
 }  // namespace
 
 BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions options)
-    : options_(std::move(options)),
+    : options_(validated(std::move(options))),
       beacon_pose_topic_(ros_topic(options_.ros_namespace, "beacon_pose")),
       odometry_out_topic_(ros_topic(options_.ros_namespace, "odometry/beacons")),
       beacons_topic_(ros_topic(options_.ros_namespace, "beacons")),
@@ -49,7 +54,7 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
       odom_in_topic_(ros_topic(options_.ros_namespace, "odom")),
       scan_in_topic_(ros_topic(options_.ros_namespace, "scan")),
       initial_pose_topic_(ros_topic(options_.ros_namespace, "initialpose")),
-      participant_((check_namespace(options_.ros_namespace), dds), "beaconloc.bridge." + options_.robot_id) {
+      participant_(dds, "beaconloc.bridge." + options_.robot_id) {
   using geometry_msgs::msg::PoseWithCovarianceStampedPubSubType;
   beacon_pose_writer_ = participant_.writer<PoseWithCovarianceStampedPubSubType>(
       {beacon_pose_topic_.c_str(), "ros2.beacon_pose.writer", ""});

@@ -6,11 +6,6 @@
 
 namespace beaconloc::bridge {
 
-Pose2 inverse(const Pose2& t) {
-  const double c = std::cos(t.z()), s = std::sin(t.z());
-  return {-c * t.x() - s * t.y(), s * t.x() - c * t.y(), wrap_angle_rad(-t.z())};
-}
-
 bool OdomFrame::push(StampNs stamp_ns, const Pose2& pose) {
   if (!poses_.empty() && stamp_ns <= poses_.back().first) return false;
   poses_.emplace_back(stamp_ns, pose);
@@ -61,7 +56,7 @@ std::optional<Pose2> OdomFrame::pose_odom_base(StampNs stamp_ns) const {
 std::optional<Pose2> OdomFrame::pose_map_odom(StampNs stamp_ns, const Pose2& pose_map_base) const {
   const auto odom_base = pose_odom_base(stamp_ns);
   if (!odom_base) return std::nullopt;
-  return compose(pose_map_base, inverse(*odom_base));
+  return compose(pose_map_base, between(*odom_base, Pose2::Zero()));  // T_map_base * T_odom_base^-1
 }
 
 }  // namespace beaconloc::bridge

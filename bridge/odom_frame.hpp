@@ -39,7 +39,4 @@ class OdomFrame {
   double omega_radps_ = 0.0;
 };
 
-// The inverse of a planar transform and composition live in core/pose2.hpp (compose).
-Pose2 inverse(const Pose2& t);
-
 }  // namespace beaconloc::bridge

@@ -7,7 +7,9 @@ namespace {
 
 constexpr int kPlanarIndex[3] = {0, 1, 5};  // x, y, yaw in (x, y, z, roll, pitch, yaw)
 
-std::optional<OdometrySample> refuse(std::string* why_not, const char* reason) {
+// A conversion's refusal: the reason, for the caller to count, and nothing converted.
+template <class T>
+std::optional<T> refused(std::string* why_not, const char* reason) {
   if (why_not) *why_not = reason;
   return std::nullopt;
 }
@@ -84,30 +86,27 @@ geometry_msgs::msg::PoseWithCovarianceStamped to_pose_with_covariance(const Pose
 
 std::optional<InitialPose> from_initial_pose(const geometry_msgs::msg::PoseWithCovarianceStamped& m,
                                              std::string* why_not) {
-  auto fail = [&](const char* reason) -> std::optional<InitialPose> {
-    if (why_not) *why_not = reason;
-    return std::nullopt;
-  };
   const auto stamp = from_ros_time(m.header().stamp());
-  if (!stamp) return fail("bad_stamp");
+  if (!stamp) return refused<InitialPose>(why_not, "bad_stamp");
   const auto yaw = planar_yaw(m.pose().pose().orientation());
-  if (!yaw) return fail("not_a_planar_orientation");
+  if (!yaw) return refused<InitialPose>(why_not, "not_a_planar_orientation");
   const double x = m.pose().pose().position().x(), y = m.pose().pose().position().y();
-  if (!std::isfinite(x) || !std::isfinite(y)) return fail("non_finite_position");
+  if (!std::isfinite(x) || !std::isfinite(y)) return refused<InitialPose>(why_not, "non_finite_position");
   const Cov3 c = planar_covariance(m.pose().covariance().data());
-  if (!c.allFinite() || !(c.diagonal().array() > 0.0).all()) return fail("covariance_not_positive");
+  if (!c.allFinite() || !(c.diagonal().array() > 0.0).all())
+    return refused<InitialPose>(why_not, "covariance_not_positive");
   return InitialPose{*stamp, Pose2(x, y, *yaw), c};
 }
 
 std::optional<OdometrySample> from_ros_odometry(const nav_msgs::msg::Odometry& m, double wheel_base_m,
                                                 std::string* why_not) {
   const auto stamp = from_ros_time(m.header().stamp());
-  if (!stamp) return refuse(why_not, "bad_stamp");
+  if (!stamp) return refused<OdometrySample>(why_not, "bad_stamp");
   const double v = m.twist().twist().linear().x(), omega = m.twist().twist().angular().z();
-  if (!std::isfinite(v) || !std::isfinite(omega)) return refuse(why_not, "non_finite_twist");
+  if (!std::isfinite(v) || !std::isfinite(omega)) return refused<OdometrySample>(why_not, "non_finite_twist");
   const double var_v = m.twist().covariance()[0], var_omega = m.twist().covariance()[35];
   if (!std::isfinite(var_v) || !std::isfinite(var_omega) || var_v < 0.0 || var_omega < 0.0) {
-    return refuse(why_not, "bad_twist_covariance");
+    return refused<OdometrySample>(why_not, "bad_twist_covariance");
   }
   OdometrySample o;
   o.stamp_ns = *stamp;
@@ -123,21 +122,17 @@ std::optional<OdometrySample> from_ros_odometry(const nav_msgs::msg::Odometry& m
 }
 
 std::optional<LaserScanSample> from_ros_scan(const sensor_msgs::msg::LaserScan& m, std::string* why_not) {
-  auto fail = [&](const char* reason) -> std::optional<LaserScanSample> {
-    if (why_not) *why_not = reason;
-    return std::nullopt;
-  };
   const auto stamp = from_ros_time(m.header().stamp());
-  if (!stamp) return fail("bad_stamp");
-  if (m.ranges().empty()) return fail("no_beams");
+  if (!stamp) return refused<LaserScanSample>(why_not, "bad_stamp");
+  if (m.ranges().empty()) return refused<LaserScanSample>(why_not, "no_beams");
   if (!std::isfinite(m.angle_min()) || !std::isfinite(m.angle_increment()) || !std::isfinite(m.range_min()) ||
       !std::isfinite(m.range_max()) || !(m.range_max() > m.range_min()) || m.angle_increment() == 0.0f) {
-    return fail("bad_scan_geometry");
+    return refused<LaserScanSample>(why_not, "bad_scan_geometry");
   }
   // angle_max must be where the beams end (REP-117 scans carry both).
   const double last = m.angle_min() + static_cast<double>(m.ranges().size() - 1) * m.angle_increment();
   if (!std::isfinite(m.angle_max()) || std::abs(last - m.angle_max()) > std::abs(m.angle_increment())) {
-    return fail("angles_do_not_match_the_beams");
+    return refused<LaserScanSample>(why_not, "angles_do_not_match_the_beams");
   }
   LaserScanSample s;
   s.stamp_ns = *stamp;

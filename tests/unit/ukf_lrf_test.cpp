@@ -9,6 +9,7 @@
 
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/occupancy_grid_io.hpp"
+#include "exact_ranges.hpp"
 #include "ukf_lrf/beacon_association.hpp"
 #include "ukf_lrf/laser_model.hpp"
 
@@ -144,8 +145,9 @@ class RoomDrive {
  public:
   explicit RoomDrive(const std::string& estimator) {
     EstimatorConfig config;
-    config.receivers.receivers_base_m = {{0.0, 0.0}};
-    config.receivers.receiver_height_m = 0.3;
+    receivers_.receivers_base_m = {{0.0, 0.0}};
+    receivers_.receiver_height_m = 0.3;
+    config.receivers = receivers_;
     config.occupancy_grid = std::make_shared<const OccupancyGrid>(room());
     config.initial_pose = truth_;
     ukf_ = EstimatorRegistry::instance().create(estimator, config);
@@ -177,16 +179,13 @@ class RoomDrive {
     return s;
   }
   RangeMeasurement range(StampNs stamp_ns, std::uint32_t beacon_id) const {
-    RangeMeasurement r;
-    r.stamp_ns = stamp_ns;
+    RangeMeasurement r =
+        test_support::exact_ranges(truth_, receivers_, *map_.find(beacon_id), stamp_ns, 0.16).front();
     r.beacon_id = kBeaconUnidentified;  // anonymous
-    const Eigen::Vector3d d =
-        map_.find(beacon_id)->position_map_m - Eigen::Vector3d(truth_.x(), truth_.y(), 0.3);
-    r.range_m = d.norm();
-    r.variance_m2 = 0.16;
     return r;
   }
   std::unique_ptr<Estimator> ukf_;
+  ReceiverArray receivers_;
   BeaconMap map_;
   Pose2 truth_{0.6, 1.5, 0.0};
   StampNs stamp_ns_ = 0;

@@ -35,12 +35,6 @@ UhlOptions uhl_options(const EstimatorConfig& config) {
   return o;
 }
 
-Pose2 pose_difference(const Pose2& a, const Pose2& b) {
-  Pose2 d = a - b;
-  d.z() = wrap_angle_rad(d.z());
-  return d;
-}
-
 }  // namespace
 
 Cov3 uhl_observation_covariance(const std::vector<TxDistances>& txs, const UhlSolution& solution,

@@ -360,10 +360,7 @@ UhlJacobian uhl_jacobian_numeric(const std::vector<TxDistances>& txs, const UhlO
       lo[i].distances_m(l) -= h;
       const UhlSolution a = solve_uhl(hi, options), b = solve_uhl(lo, options);
       if (a.ok && b.ok)
-        j.col(3 * static_cast<Eigen::Index>(i) + l) =
-            Eigen::Vector3d(a.pose.x() - b.pose.x(), a.pose.y() - b.pose.y(),
-                            wrap_angle_rad(a.pose.z() - b.pose.z())) /
-            (2 * h);
+        j.col(3 * static_cast<Eigen::Index>(i) + l) = pose_difference(a.pose, b.pose) / (2 * h);
     }
   }
   return j;

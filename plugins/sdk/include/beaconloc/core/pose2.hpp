@@ -29,4 +29,10 @@ inline Pose2 between(const Pose2& a, const Pose2& b) {
   return {c * d.x() + s * d.y(), -s * d.x() + c * d.y(), wrap_angle_rad(b.z() - a.z())};
 }
 
+// a - b with the heading difference wrapped to (-pi, pi]: an innovation or a numeric derivative
+// of poses.
+inline Pose2 pose_difference(const Pose2& a, const Pose2& b) {
+  return {a.x() - b.x(), a.y() - b.y(), wrap_angle_rad(a.z() - b.z())};
+}
+
 }  // namespace beaconloc
