@@ -1,13 +1,22 @@
 #!/usr/bin/env bash
-# Configures and builds one configuration: bash scripts/build.sh [Release|Debug]
-# into build/release or build/debug. Two compile jobs: ~330 MB each, sized for 2 cores.
+# Configures and builds one configuration: bash scripts/build.sh [Release|Debug|Asan]
+# into build/release, build/debug or build/asan. Asan is Debug (Eigen's assertions on) with
+# AddressSanitizer and UndefinedBehaviorSanitizer (BEACONLOC_SANITIZE, see CMakeLists.txt) and
+# without the benchmarks; run its tests with scripts/sanitizers.env in the environment.
+# Two compile jobs: ~330 MB each, sized for 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 type="${1:-Release}"
 case "$type" in
   Release) dir=build/release ;;
   Debug) dir=build/debug ;;
-  *) echo "build.sh: unknown build type '$type' (Release or Debug)" >&2; exit 2 ;;
+  Asan) dir=build/asan ;;
+  *) echo "build.sh: unknown build type '$type' (Release, Debug or Asan)" >&2; exit 2 ;;
 esac
-cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE="$type" -DBEACONLOC_WERROR=ON >/dev/null
+if [ "$type" = Asan ]; then
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DBEACONLOC_SANITIZE=ON -DBEACONLOC_BUILD_BENCHMARKS=OFF \
+    -DBEACONLOC_WERROR=ON >/dev/null
+else
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE="$type" -DBEACONLOC_WERROR=ON >/dev/null
+fi
 cmake --build "$dir" -j 2

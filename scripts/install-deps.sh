@@ -10,4 +10,7 @@ $SUDO apt-get install -y --no-install-recommends \
   libfastrtps-dev libfastcdr-dev fastddsgen \
   libeigen3-dev libcli11-dev libyaml-cpp-dev \
   libgtest-dev libgmock-dev libbenchmark-dev \
-  cyclonedds-dev cyclonedds-tools
+  cyclonedds-dev cyclonedds-tools \
+  clang libclang-rt-14-dev llvm
+# clang, libclang-rt-14-dev (libFuzzer, ASan and UBSan runtimes) and llvm (llvm-symbolizer, for
+# readable reports): the fuzz targets, scripts/fuzz.sh.

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 #include <thread>
 
 #include "beaconloc/core/csv_reader.hpp"
@@ -17,6 +18,7 @@
 #include "offline_run.hpp"
 #include "pipeline.hpp"
 #include "pose_recorder.hpp"
+#include "sim/faults.hpp"
 #include "sim/scenario_yaml.hpp"
 
 namespace beaconloc::cli {
@@ -62,6 +64,9 @@ void add_source_options(CLI::App* app, SourceChoice& s) {
   app->add_option("--replay-odometry-k-v", s.replay.odometry_k_v_m,
                   "odometry noise reported with replayed samples: sigma_v^2 = k_v |v| / dT per wheel")
       ->check(kNonNegative);
+  app->add_option("--fault", s.faults,
+                  "inject a fault into the simulation (repeatable): beacon_dies=ID@T, tof_outage=FROM:TO "
+                  "(seconds), echoes=P");
 }
 
 void add_gateway_options(CLI::App* app, GatewayOptions& o, std::optional<std::uint64_t>& seed) {
@@ -247,6 +252,17 @@ int run(int argc, char** argv) {
                    "position error and the association rates (seed 001 Tables 4-7)")
       ->check(CLI::IsMember({"pose", "distance"}));
   accuracy->add_option("--out", accuracy_out, "also write the table to this file");
+  std::vector<std::string> accuracy_faults;
+  double accuracy_delay_ms = 0.0;
+  accuracy->add_option(
+      "--fault", accuracy_faults,
+      "also score the scenarios with this fault (repeatable, all at once): beacon_dies=ID@T, "
+      "tof_outage=FROM:TO, echoes=P; the clean row comes first");
+  accuracy
+      ->add_option("--delay-ms", accuracy_delay_ms,
+                   "also score with every TOF and scan delivered late by a uniform random 0..D ms "
+                   "(odometry on time); the in-order row comes first")
+      ->check(kNonNegative);
 
   auto* monitor = app.add_subcommand(
       "monitor", "print the poses on the bus each second; with --truth, the accuracy at the end");
@@ -304,24 +320,59 @@ int run(int argc, char** argv) {
     }
     if (accuracy->parsed()) {
       std::vector<AccuracyRow> rows;
+      const bool variants_compared = !accuracy_faults.empty() || accuracy_delay_ms > 0.0;
       for (const auto& file : accuracy_scenarios) {
-        sim::Scenario scenario = sim::load_scenario_file(file);
-        if (accuracy_odometry_k_v_m) scenario.odometry_k_v_m = *accuracy_odometry_k_v_m;
-        for (const auto& estimator : accuracy_estimators) {
-          AccuracyRow row{scenario.name, estimator, {}, {}};
-          for (int k = 0; k < accuracy_seeds; ++k) {
-            const OfflineRunResult r =
-                run_scenario_offline(scenario, accuracy_first_seed + static_cast<std::uint64_t>(k), estimator,
-                                     accuracy_parameters, accuracy_settle_s);
-            row.runs.push_back(r.metrics);
-            if (r.associations.total()) row.associations.push_back(r.associations);
+        sim::Scenario clean = sim::load_scenario_file(file);
+        if (accuracy_odometry_k_v_m) clean.odometry_k_v_m = *accuracy_odometry_k_v_m;
+        // The clean, in-order row, then the same seeds with the faults and the delay.
+        struct Variant {
+          std::string label;
+          sim::Scenario scenario;
+          Delivery delivery;
+        };
+        std::vector<Variant> variants{{clean.name, clean, {}}};
+        if (variants_compared) {
+          Variant v{clean.name, clean, {}};
+          for (const auto& fault : accuracy_faults) {
+            sim::apply_fault(v.scenario, fault);
+            v.label += " + " + fault;
           }
-          rows.push_back(row);
+          if (accuracy_delay_ms > 0.0) {
+            v.delivery.max_measurement_delay_ns = s_to_ns(accuracy_delay_ms * 1e-3);
+            std::ostringstream label;
+            label << " + delay 0.." << accuracy_delay_ms << " ms";
+            v.label += label.str();
+          }
+          variants.push_back(v);
+        }
+        for (const auto& estimator : accuracy_estimators) {
+          for (const auto& variant : variants) {
+            AccuracyRow row{variant.label, estimator, {}, {}, {}};
+            for (int k = 0; k < accuracy_seeds; ++k) {
+              const OfflineRunResult r =
+                  run_scenario_offline(variant.scenario, accuracy_first_seed + static_cast<std::uint64_t>(k),
+                                       estimator, accuracy_parameters, accuracy_settle_s, variant.delivery);
+              row.runs.push_back(r.metrics);
+              if (r.associations.total()) row.associations.push_back(r.associations);
+              for (const auto& [reason, n] : r.rejections.rejected_by_reason()) row.rejections[reason] += n;
+            }
+            rows.push_back(row);
+          }
         }
       }
       const std::string table =
           accuracy_table == "distance" ? distance_table_markdown(rows) : accuracy_table_markdown(rows);
       std::cout << table;
+      if (variants_compared) {
+        // What the faults cost: the typed refusals of the decoder and localizer, over all seeds.
+        std::cout << "\nrefusals summed over the seeds:\n";
+        for (const auto& row : rows) {
+          std::cout << "- " << row.scenario << ", " << row.estimator << ":";
+          if (row.rejections.empty()) std::cout << " none";
+          for (const auto& [reason, n] : row.rejections) std::cout << ' ' << reason << '=' << n;
+          std::cout << '\n';
+        }
+      }
       if (!accuracy_out.empty()) {
         std::ofstream out(accuracy_out);
         out << table;

@@ -21,6 +21,7 @@
 #include "diagnostics_recorder.hpp"
 #include "localizer_participant.hpp"
 #include "pose_recorder.hpp"
+#include "sim/faults.hpp"
 #include "sim/scenario_yaml.hpp"
 #include "sim/sim_source.hpp"
 #include "svg_plot.hpp"
@@ -296,6 +297,10 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
     gateway_args.push_back("--scenario");
     gateway_args.push_back(source.choice.scenario_file);
   }
+  for (const auto& fault : source.choice.faults) {
+    gateway_args.push_back("--fault");
+    gateway_args.push_back(fault);
+  }
 
   ChildProcess localizer(exe, localizer_args, o.out_dir + "/localizer.log");
   ChildProcess decoder(exe, decoder_args, o.out_dir + "/decoder.log");
@@ -359,6 +364,7 @@ LoadedSource load_source(const SourceChoice& choice, std::optional<std::uint64_t
   LoadedSource out;
   out.choice = choice;
   if (!choice.replay_dir.empty()) {
+    if (!choice.faults.empty()) throw std::invalid_argument("--fault needs a simulated source, not --replay");
     auto replay = std::make_unique<ReplaySource>(choice.replay_dir, choice.replay);
     for (const auto& problem : replay->load_problems())
       std::fprintf(stderr, "replay: refused %s\n", problem.c_str());
@@ -371,6 +377,7 @@ LoadedSource load_source(const SourceChoice& choice, std::optional<std::uint64_t
   }
   sim::Scenario scenario =
       choice.scenario_file.empty() ? sim::default_scenario() : sim::load_scenario_file(choice.scenario_file);
+  for (const auto& fault : choice.faults) sim::apply_fault(scenario, fault);
   out.seed = seed.value_or(scenario.seed);
   out.label = "scenario " + scenario.name;
   out.scenario = scenario;

@@ -22,6 +22,7 @@ struct SourceChoice {
   std::string scenario_file;  // empty: built-in default (unless replay_dir)
   std::string replay_dir;
   ReplayOptions replay;
+  std::vector<std::string> faults;  // sim/faults.hpp forms; simulated sources only
 };
 
 struct LoadedSource {

@@ -19,8 +19,12 @@ DecoderParticipant::DecoderParticipant(const dds::DdsOptions& dds, TofDecoderCon
     }
     for (const auto& range : held) publish(range);
   });
+  dds::ReaderEvents<msg::RawTof> tof_events;
+  tof_events.deadline_misses = &deadline_misses_;
+  tof_events.writers_lost = &tof_writers_lost_;
+  tof_events.lost_and_none_alive = &tof_writer_lost_;
   participant_.subscribe<msg::RawTofPubSubType>(
-      dds::kRawTofTopic, [this](const msg::RawTof& m) { on_raw_tof(m); }, &deadline_misses_);
+      dds::kRawTofTopic, [this](const msg::RawTof& m) { on_raw_tof(m); }, tof_events);
   diagnostics_ =
       std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] { return diagnostics_snapshot(); });
 }
@@ -57,11 +61,20 @@ void DecoderParticipant::publish(const DecodedRange& d) {
 
 msg::Diagnostics DecoderParticipant::diagnostics_snapshot() {
   std::lock_guard<std::mutex> lock(mutex_);
-  const bool has_map = decoder_.has_beacon_map();
-  return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), decoder_.counts(),
-                               deadline_misses_.load(),
-                               has_map ? msg::PARTICIPANT_STATUS_OK : msg::PARTICIPANT_STATUS_DEGRADED,
-                               has_map ? "" : "waiting for the beacon map");
+  msg::ParticipantStatus status = msg::PARTICIPANT_STATUS_OK;
+  std::string message;
+  if (!decoder_.has_beacon_map()) {
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message = "waiting for the beacon map";
+  } else if (tof_writer_lost_.load()) {
+    // A gateway was there and is gone (liveliness lost: its process died or hung).
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message = "no live TOF writer: the gateway was lost";
+  }
+  auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), decoder_.counts(),
+                                 deadline_misses_.load(), status, message);
+  d.writers_lost(tof_writers_lost_.load());
+  return d;
 }
 
 }  // namespace beaconloc

@@ -33,6 +33,8 @@ class DecoderParticipant {
   std::mutex mutex_;
   TofDecoder decoder_;
   std::atomic<std::uint64_t> deadline_misses_{0};
+  std::atomic<std::uint64_t> tof_writers_lost_{0};
+  std::atomic<bool> tof_writer_lost_{false};  // lost, none alive since
   std::atomic<std::uint64_t> tofs_processed_{0};
   std::atomic<std::uint64_t> ranges_written_{0};
   dds::Participant participant_;

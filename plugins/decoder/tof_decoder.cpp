@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "beaconloc/core/speed_of_sound.hpp"
@@ -26,6 +27,10 @@ const char* to_string(TofRejection r) {
       return "stale";
     case TofRejection::kDuplicate:
       return "duplicate";
+    case TofRejection::kBadStamp:
+      return "bad_stamp";
+    case TofRejection::kTimeJump:
+      return "time_jump";
   }
   return "unknown_reason";
 }
@@ -48,6 +53,13 @@ TofDecoder::TofDecoder(TofDecoderConfig config) : config_(config) {
   }
   if (!(config_.max_range_m > config_.min_range_m))
     throw std::invalid_argument("max_range_m must exceed min_range_m");
+  if (config_.max_age_ns < 0) throw std::invalid_argument("max_age_ns must not be negative");
+  if (config_.max_jump_ns < 0) throw std::invalid_argument("max_jump_ns must not be negative");
+  // A jump is what lies beyond the useful life of a TOF, never within it.
+  const StampNs twice_max_age_ns = config_.max_age_ns > std::numeric_limits<StampNs>::max() / 2
+                                       ? std::numeric_limits<StampNs>::max()
+                                       : 2 * config_.max_age_ns;
+  config_.max_jump_ns = std::max(config_.max_jump_ns, twice_max_age_ns);
 }
 
 DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample& tof) {
@@ -61,11 +73,15 @@ DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample
   if (range_m < config_.min_range_m || range_m > config_.max_range_m) {
     return reject(TofRejection::kOutOfRangeTof);
   }
+  // The arrival, fire stamp + TOF, must be a stamp too (the TOF bound keeps s_to_ns defined).
+  if (tof.tof_s >= 9e9 || tof.fire_stamp_ns > std::numeric_limits<StampNs>::max() - s_to_ns(tof.tof_s)) {
+    return reject(TofRejection::kBadStamp);
+  }
   if (tof.beacon_id != kBeaconUnidentified && map_.empty()) {
     // Hold it for the map; what ages out of the backlog, or overflows it, is refused.
     while (!backlog_.empty() &&
            (backlog_.size() >= kMaxBacklog ||
-            backlog_.front().second.fire_stamp_ns < tof.fire_stamp_ns - config_.max_age_ns)) {
+            older_than(backlog_.front().second.fire_stamp_ns, tof.fire_stamp_ns, config_.max_age_ns))) {
       backlog_.pop_front();
       counts_.reject(to_string(TofRejection::kNoBeaconMap));
     }
@@ -96,17 +112,36 @@ DecodeOutcome TofDecoder::decode_with_map(const std::string& robot_id, const Raw
   if (identified && !map_.find(tof.beacon_id)) return reject(TofRejection::kUnknownBeacon);
 
   RobotState& robot = robots_[robot_id];
-  if (robot.seen_any && tof.fire_stamp_ns < robot.newest_fire_stamp_ns - config_.max_age_ns) {
+  bool new_time_line = false;
+  // Forwards, any gap is taken: beacons go unheard for seconds (a corridor without beacons, a
+  // recording's gaps). Far behind the newest firing is a clock that stepped back, or the
+  // robot's time line resuming after one bad stamp far ahead: a second, different firing near
+  // this one confirms it, and the decoder follows.
+  if (robot.seen_any && older_than(tof.fire_stamp_ns, robot.newest_fire_stamp_ns, config_.max_jump_ns)) {
+    const auto& candidate = robot.jump_candidate_ns;
+    new_time_line = candidate && *candidate != tof.fire_stamp_ns &&
+                    !older_than(tof.fire_stamp_ns, *candidate, config_.max_age_ns) &&
+                    !older_than(*candidate, tof.fire_stamp_ns, config_.max_age_ns);
+    if (!new_time_line) {
+      robot.jump_candidate_ns = tof.fire_stamp_ns;
+      return reject(TofRejection::kTimeJump);
+    }
+    robot.recent.clear();
+    robot.jump_candidate_ns.reset();
+  } else if (robot.seen_any &&
+             older_than(tof.fire_stamp_ns, robot.newest_fire_stamp_ns, config_.max_age_ns)) {
     return reject(TofRejection::kStale);
   }
+  if (!new_time_line) robot.jump_candidate_ns.reset();  // a firing on the time line: no jump pending
   const auto key = std::make_pair(tof.sequence_number, tof.fire_stamp_ns);
   if (std::find(robot.recent.begin(), robot.recent.end(), key) != robot.recent.end()) {
     return reject(TofRejection::kDuplicate);
   }
   robot.recent.push_back(key);
   if (robot.recent.size() > 64) robot.recent.pop_front();
-  robot.newest_fire_stamp_ns =
-      robot.seen_any ? std::max(robot.newest_fire_stamp_ns, tof.fire_stamp_ns) : tof.fire_stamp_ns;
+  robot.newest_fire_stamp_ns = robot.seen_any && !new_time_line
+                                   ? std::max(robot.newest_fire_stamp_ns, tof.fire_stamp_ns)
+                                   : tof.fire_stamp_ns;
   robot.seen_any = true;
 
   DecodedRange out;

@@ -24,6 +24,8 @@ enum class TofRejection {
   kUnknownBeacon,   // beacon id not in the map
   kStale,           // fired longer ago than max_age_ns before the newest firing of the robot
   kDuplicate,       // same sequence number and firing stamp seen already
+  kBadStamp,        // fired so near the end of the clock that the arrival (fire + TOF) overflows it
+  kTimeJump,        // fired more than max_jump_ns before the newest firing, not (yet) confirmed
 };
 const char* to_string(TofRejection r);
 
@@ -34,6 +36,12 @@ struct TofDecoderConfig {
   double min_temperature_c = -30.0;
   double max_temperature_c = 60.0;
   StampNs max_age_ns = 600 * kNsPerMillisecond;  // three 200 ms slots
+  // A firing this far (five slots; at least twice max_age_ns) behind the robot's newest is a
+  // clock that stepped back, or the true time line after one bad stamp far ahead: refused
+  // (time_jump) until a second, different firing within max_age_ns of it confirms it, then
+  // followed. Without it one bad stamp would make every good TOF after it stale. (The localizer
+  // restarts a robot whose odometry goes back over 1 s.)
+  StampNs max_jump_ns = kNsPerSecond;
   // Calibration of the ranging system: range = c * tof / range_scale. 1 for ultrasonic TOF;
   // e.g. 1.069 for the radios of the CMU Plaza recordings (datasets/README.md), whose ranges
   // read 6.9 % long.
@@ -74,6 +82,7 @@ class TofDecoder {
   struct RobotState {
     StampNs newest_fire_stamp_ns = 0;
     bool seen_any = false;
+    std::optional<StampNs> jump_candidate_ns;  // fire stamp of a refused jump, awaiting confirmation
     std::deque<std::pair<std::uint64_t, StampNs>> recent;  // (sequence, fire stamp)
   };
   TofDecoderConfig config_;

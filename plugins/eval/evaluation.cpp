@@ -46,6 +46,12 @@ const std::vector<std::string> kEstimateColumns = {
     "robot_id", "stamp_ns", "x_m",    "y_m",    "yaw_rad", "cov_00", "cov_01", "cov_02",
     "cov_10",   "cov_11",   "cov_12", "cov_20", "cov_21",  "cov_22", "status", "estimator"};
 
+// Seconds from t0 to t, for any two stamps (their difference may not fit an int64).
+double seconds_since(StampNs t0, StampNs t) {
+  const auto u0 = static_cast<std::uint64_t>(t0), u = static_cast<std::uint64_t>(t);
+  return t >= t0 ? static_cast<double>(u - u0) * 1e-9 : -static_cast<double>(u0 - u) * 1e-9;
+}
+
 PoseStatus status_from(const std::string& s, const std::string& where) {
   for (PoseStatus p :
        {PoseStatus::kInitializing, PoseStatus::kOk, PoseStatus::kDegraded, PoseStatus::kLost}) {
@@ -131,7 +137,7 @@ std::vector<ErrorPoint> error_series(const TruthTrack& truth, const std::vector<
     if (!t) continue;
     const Pose2& est = row.estimate.pose_map_base;
     ErrorPoint p{
-        ns_to_s(row.estimate.stamp_ns - t0), (t->pose_map_base.head<2>() - est.head<2>()).norm(), {}};
+        seconds_since(t0, row.estimate.stamp_ns), (t->pose_map_base.head<2>() - est.head<2>()).norm(), {}};
     if (t->has_yaw) p.heading_deg = wrap_angle_rad(t->pose_map_base.z() - est.z()) * 180.0 / M_PI;
     out.push_back(p);
   }

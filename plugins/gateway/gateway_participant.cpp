@@ -45,6 +45,13 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
   }
   const double source_s = ns_to_s(source_->last_stamp_ns() - source_->first_stamp_ns());
   total_s_ = options_.duration_s > 0.0 ? options_.duration_s : source_s;
+  // raw_tof and odometry liveliness is manual by topic (examples/qos/topics.xml): this process
+  // asserts it every 250 ms (lease 1 s), so readers notice a gateway that dies, while one that
+  // hears no beacon, waits for a slow pipeline or replays a gap in a recording stays alive.
+  liveliness_ = std::make_unique<dds::PeriodicTask>(std::chrono::milliseconds(250), [this] {
+    tof_writer_->assert_liveliness();
+    odometry_writer_->assert_liveliness();
+  });
   diagnostics_ = std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] {
     std::lock_guard<std::mutex> lock(counts_mutex_);
     RejectionCounter counts = counts_;
@@ -57,6 +64,7 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
 }
 
 GatewayParticipant::~GatewayParticipant() {
+  liveliness_.reset();
   stop();
   diagnostics_->stop();
   participant_.close();

@@ -15,6 +15,7 @@
 #include "beaconloc/core/rejection_counter.hpp"
 #include "beaconloc/dds/diagnostics_publisher.hpp"
 #include "beaconloc/dds/participant.hpp"
+#include "beaconloc/dds/periodic_task.hpp"
 #include "source.hpp"
 
 namespace beaconloc {
@@ -86,6 +87,7 @@ class GatewayParticipant {
   std::mutex counts_mutex_;
   RejectionCounter counts_;  // accepted = samples written; rejected = write failures
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
+  std::unique_ptr<dds::PeriodicTask> liveliness_;  // asserts the TOF and odometry writers' liveliness
   GatewayProgress progress_;
   std::atomic<double> elapsed_s_{0.0};
   double total_s_ = 0.0;

@@ -14,7 +14,7 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
 
 void LocalizerCore::set_beacon_map(const BeaconMap& map) {
   map_ = map;
-  for (auto& [id, r] : robots_) r.estimator->set_beacon_map(map_);
+  for (auto& [id, r] : robots_) r.fusion.set_beacon_map(map_);
 }
 
 LocalizerCore::Robot* LocalizerCore::robot(const std::string& robot_id, const char* kind) {
@@ -28,10 +28,9 @@ LocalizerCore::Robot* LocalizerCore::robot(const std::string& robot_id, const ch
   }
   auto it = robots_.find(robot_id);
   if (it == robots_.end()) {
-    Robot r;
-    r.estimator = EstimatorRegistry::instance().create(estimator_name_, config_);
-    r.estimator->set_beacon_map(map_);
-    it = robots_.emplace(robot_id, std::move(r)).first;
+    it = robots_.emplace(robot_id, Robot(EstimatorRegistry::instance().create(estimator_name_, config_)))
+             .first;
+    it->second.fusion.set_beacon_map(map_);
   }
   return &it->second;
 }
@@ -40,15 +39,35 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
                                                           const OdometrySample& odometry) {
   Robot* r = robot(robot_id, "odometry");
   if (!r) return std::nullopt;
-  const InputResult result = r->estimator->predict(odometry);
-  for (const auto& reason : r->estimator->take_deferred_rejections()) counts_.reject("deferred." + reason);
+  InputResult result = r->fusion.predict(odometry);
+  for (const auto& reason : r->fusion.take_deferred_rejections()) counts_.reject("deferred." + reason);
+  if (!result.accepted && result.rejection == "out_of_order_odometry" && clock_jumped_back(*r, odometry)) {
+    // The robot's clock stepped back (a restarted gateway replaying, a reset clock): what the
+    // estimator holds belongs to the old time line. A new one starts on the new time line, from
+    // where the robot was (a clock jump does not move it), less sure; an estimator that had no
+    // pose yet, or cannot be placed, finds it from the beacons.
+    counts_.reject("odometry.clock_jumped_back");
+    const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
+    EstimatorConfig restart = config_;
+    restart.initial_pose.reset();  // not the run's start pose
+    *r = Robot(EstimatorRegistry::instance().create(estimator_name_, restart));
+    r->fusion.set_beacon_map(map_);
+    result = r->fusion.predict(odometry);
+    if (before && result.accepted) {
+      const Cov3 inflated =
+          before->covariance + Eigen::Vector3d(0.01, 0.01, 0.01).asDiagonal().toDenseMatrix();
+      r->fusion.reset(odometry.stamp_ns, before->pose_map_base, inflated);
+    }
+  }
   if (!result.accepted) {
     counts_.reject("odometry." + result.rejection);
     return std::nullopt;
   }
+  r->jump_candidate_ns.reset();
   counts_.accept();
-  auto estimate = r->estimator->estimate();
+  auto estimate = r->fusion.estimator().estimate();
   if (!estimate) return std::nullopt;
+  estimate->status = r->status();
   LocalizerOutput out{robot_id, *estimate, {r->beacons_used.begin(), r->beacons_used.end()}};
   r->beacons_used.clear();
   return out;
@@ -57,7 +76,8 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
 void LocalizerCore::on_range(const std::string& robot_id, const RangeMeasurement& range) {
   Robot* r = robot(robot_id, "range");
   if (!r) return;
-  const InputResult result = r->estimator->update(range);
+  r->ranges_silent = false;  // the bus delivers ranges again; whether they fit is the estimator's call
+  const InputResult result = r->fusion.update(range);
   if (!result.accepted) {
     counts_.reject("range." + result.rejection);
     return;
@@ -70,7 +90,7 @@ void LocalizerCore::on_laser(const std::string& robot_id, const LaserScanSample&
   if (!uses_laser_) return;  // the participant does not subscribe to scans then; nothing to count
   Robot* r = robot(robot_id, "laser");
   if (!r) return;
-  const InputResult result = r->estimator->update_laser(scan);
+  const InputResult result = r->fusion.update_laser(scan);
   if (!result.accepted) {
     counts_.reject("laser." + result.rejection);
     return;
@@ -82,7 +102,7 @@ void LocalizerCore::on_initial_pose(const std::string& robot_id, StampNs stamp_n
                                     const Cov3& covariance) {
   Robot* r = robot(robot_id, "initial_pose");
   if (!r) return;
-  const InputResult result = r->estimator->reset(stamp_ns, pose, covariance);
+  const InputResult result = r->fusion.reset(stamp_ns, pose, covariance);
   if (!result.accepted) {
     counts_.reject("initial_pose." + result.rejection);
     return;
@@ -92,27 +112,64 @@ void LocalizerCore::on_initial_pose(const std::string& robot_id, StampNs stamp_n
 
 std::vector<Estimator::Association> LocalizerCore::take_associations(const std::string& robot_id) {
   auto it = robots_.find(robot_id);
-  return it == robots_.end() ? std::vector<Estimator::Association>{}
-                             : it->second.estimator->take_associations();
+  return it == robots_.end() ? std::vector<Estimator::Association>{} : it->second.fusion.take_associations();
+}
+
+// One sample far (over a second) behind the time line is refused as out of order; a second that
+// continues from it (within 200 ms) shows the clock itself went back. Samples a little out of
+// order (two writers for one robot, a misconfiguration) are refused without a restart.
+bool LocalizerCore::clock_jumped_back(Robot& r, const OdometrySample& odometry) {
+  const auto newest_ns = r.fusion.newest_odometry_ns();
+  if (!newest_ns || !older_than(odometry.stamp_ns, *newest_ns, kClockJumpMinNs)) return false;
+  const auto& candidate = r.jump_candidate_ns;
+  if (candidate && odometry.stamp_ns > *candidate &&
+      !older_than(*candidate, odometry.stamp_ns, kClockJumpConfirmationNs)) {
+    return true;
+  }
+  r.jump_candidate_ns = odometry.stamp_ns;
+  return false;
+}
+
+void LocalizerCore::on_ranges_silent(const std::string& robot_id) {
+  auto it = robots_.find(robot_id);
+  if (it != robots_.end()) it->second.ranges_silent = true;
+}
+
+std::uint64_t LocalizerCore::replays() const {
+  std::uint64_t n = 0;
+  for (const auto& [id, r] : robots_) n += r.fusion.replays();
+  return n;
+}
+
+namespace {
+int severity(PoseStatus s) {
+  switch (s) {
+    case PoseStatus::kOk:
+      return 0;
+    case PoseStatus::kInitializing:
+      return 1;
+    case PoseStatus::kDegraded:
+      return 2;
+    case PoseStatus::kLost:
+      return 3;
+  }
+  return 3;
+}
+}  // namespace
+
+PoseStatus LocalizerCore::Robot::status() const {
+  const PoseStatus estimator_status = fusion.estimator().status();
+  // Silent ranges make a good pose degraded at once, rather than after the estimator's own
+  // 1 s of data time without a fused range.
+  if (ranges_silent && severity(estimator_status) < severity(PoseStatus::kDegraded))
+    return PoseStatus::kDegraded;
+  return estimator_status;
 }
 
 PoseStatus LocalizerCore::worst_status() const {
   PoseStatus worst = PoseStatus::kOk;
-  auto rank = [](PoseStatus s) {
-    switch (s) {
-      case PoseStatus::kOk:
-        return 0;
-      case PoseStatus::kInitializing:
-        return 1;
-      case PoseStatus::kDegraded:
-        return 2;
-      case PoseStatus::kLost:
-        return 3;
-    }
-    return 3;
-  };
   for (const auto& [id, r] : robots_) {
-    if (rank(r.estimator->status()) > rank(worst)) worst = r.estimator->status();
+    if (severity(r.status()) > severity(worst)) worst = r.status();
   }
   return worst;
 }

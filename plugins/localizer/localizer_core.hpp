@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/out_of_sequence_fusion.hpp"
 #include "beaconloc/core/rejection_counter.hpp"
 
 namespace beaconloc {
@@ -39,8 +40,16 @@ class LocalizerCore {
                        const Cov3& covariance);
   // The robot's estimator's associations of anonymous ranges since last asked (evaluation).
   std::vector<Estimator::Association> take_associations(const std::string& robot_id);
+  // The bus says the robot's ranges stopped (the beacon_range reader's deadline, two slots, was
+  // missed): its poses are published degraded, coasting on odometry, until a range arrives.
+  void on_ranges_silent(const std::string& robot_id);
+  // Late measurements fused at their own stamp, over every robot (core/out_of_sequence_fusion).
+  std::uint64_t replays() const;
 
   const std::string& estimator_name() const { return estimator_name_; }
+  bool serves(const std::string& robot_id) const {
+    return robot_filter_.empty() || robot_id == robot_filter_;
+  }
   const RejectionCounter& counts() const { return counts_; }  // reasons prefixed odometry./range.
   std::size_t robot_count() const { return robots_.size(); }
   // The worst status over the robots served (kOk when none).
@@ -48,9 +57,18 @@ class LocalizerCore {
 
  private:
   struct Robot {
-    std::unique_ptr<Estimator> estimator;
+    explicit Robot(std::unique_ptr<Estimator> estimator) : fusion(std::move(estimator)) {}
+    OutOfSequenceFusion fusion;
     std::set<std::uint32_t> beacons_used;
+    bool ranges_silent = false;
+    std::optional<StampNs> jump_candidate_ns;  // an odometry stamp far behind the time line
+    PoseStatus status() const;
   };
+  // Two odometry samples in a row more than kClockJumpMinNs behind the time line, and at most
+  // kClockJumpConfirmationNs apart: the clock went back.
+  static constexpr StampNs kClockJumpMinNs = kNsPerSecond;
+  static constexpr StampNs kClockJumpConfirmationNs = 200 * kNsPerMillisecond;
+  bool clock_jumped_back(Robot& r, const OdometrySample& odometry);
   Robot* robot(const std::string& robot_id, const char* kind);
 
   std::string estimator_name_;

@@ -15,6 +15,13 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
     std::lock_guard<std::mutex> lock(mutex_);
     core_.set_beacon_map(dds::from_msg(m));
   });
+  // A robot whose ranges miss their deadline (two beacon slots) coasts on odometry, degraded.
+  dds::ReaderEvents<msg::BeaconRange> range_events;
+  range_events.deadline_misses = &deadline_misses_;
+  range_events.on_deadline_missed = [this](const msg::BeaconRange& key) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    core_.on_ranges_silent(key.robot_id());
+  };
   participant_.subscribe<msg::BeaconRangePubSubType>(
       dds::kBeaconRangeTopic,
       [this](const msg::BeaconRange& m) {
@@ -24,9 +31,14 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
         }
         ++ranges_processed_;
       },
-      &deadline_misses_);
+      range_events);
+  // The gateway's odometry writer: liveliness tells a dead gateway from a robot standing still.
+  dds::ReaderEvents<msg::Odometry> odometry_events;
+  odometry_events.deadline_misses = &deadline_misses_;
+  odometry_events.writers_lost = &odometry_writers_lost_;
+  odometry_events.lost_and_none_alive = &odometry_writer_lost_;
   participant_.subscribe<msg::OdometryPubSubType>(
-      dds::kOdometryTopic, [this](const msg::Odometry& m) { on_odometry(m); }, &deadline_misses_);
+      dds::kOdometryTopic, [this](const msg::Odometry& m) { on_odometry(m); }, odometry_events);
   if (core_.uses_laser()) {
     participant_.subscribe<msg::LaserScanPubSubType>(dds::kLaserScanTopic, [this](const msg::LaserScan& m) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -53,6 +65,18 @@ void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
   std::optional<LocalizerOutput> out;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    // Increments the bus dropped (a history too short for a stalled reader): counted, since an
+    // estimator integrating odometry cannot see that a 10 ms step is missing.
+    if (core_.serves(m.robot_id())) {
+      auto [last, first] = odometry_sequence_.try_emplace(m.robot_id(), m.sequence_number());
+      const std::uint64_t seq = m.sequence_number();
+      if (!first && seq > last->second) {
+        lost_increments_ += seq - last->second - 1;
+        last->second = seq;
+      } else if (!first && seq + kSequenceRestart < last->second) {
+        last->second = seq;  // far back: a restarted gateway numbering from 0 again
+      }
+    }
     out = core_.on_odometry(m.robot_id(), dds::from_msg(m));
   }
   if (out) {
@@ -71,11 +95,19 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   if (!core_.has_beacon_map()) {
     status = msg::PARTICIPANT_STATUS_DEGRADED;
     message = "waiting for the beacon map";
+  } else if (odometry_writer_lost_.load()) {
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message = "no live odometry writer: the gateway was lost";
   } else if (worst == PoseStatus::kDegraded || worst == PoseStatus::kLost) {
     status = msg::PARTICIPANT_STATUS_DEGRADED;
   }
-  return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), core_.counts(),
-                               deadline_misses_.load(), status, message);
+  message += "; " + std::to_string(core_.replays()) + " late measurement(s) fused at their stamp";
+  RejectionCounter counts = core_.counts();
+  counts.reject("odometry.lost_increment", lost_increments_);
+  auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, deadline_misses_.load(),
+                                 status, message);
+  d.writers_lost(odometry_writers_lost_.load());
+  return d;
 }
 
 }  // namespace beaconloc

@@ -4,8 +4,10 @@
 #include <beaconloc.h>
 
 #include <atomic>
+#include <map>
 #include <memory>
 #include <mutex>
+#include <string>
 
 #include "beaconloc/dds/diagnostics_publisher.hpp"
 #include "beaconloc/dds/participant.hpp"
@@ -29,6 +31,11 @@ class LocalizerParticipant {
   std::mutex mutex_;
   LocalizerCore core_;
   std::atomic<std::uint64_t> deadline_misses_{0};
+  std::atomic<std::uint64_t> odometry_writers_lost_{0};
+  std::map<std::string, std::uint64_t> odometry_sequence_;  // newest sequence number per robot
+  static constexpr std::uint64_t kSequenceRestart = 1000;   // 10 s of odometry back: a new writer
+  std::uint64_t lost_increments_ = 0;                       // sequence numbers never received
+  std::atomic<bool> odometry_writer_lost_{false};           // lost, none alive since
   std::atomic<std::uint64_t> odometry_processed_{0};
   std::atomic<std::uint64_t> ranges_processed_{0};
   dds::Participant participant_;

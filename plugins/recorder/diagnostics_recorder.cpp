@@ -26,6 +26,7 @@ void print_diagnostics(const std::map<std::string, msg::Diagnostics>& latest, st
     out << name << ": " << kStatus[static_cast<int>(d.status()) % 3] << ", accepted " << d.accepted();
     for (const auto& r : d.rejected()) out << ", " << r.reason() << ' ' << r.count();
     out << ", deadline misses " << d.deadline_misses();
+    if (d.writers_lost()) out << ", writers lost " << d.writers_lost();
     if (!d.message().empty()) out << " (" << d.message() << ')';
     out << '\n';
   }

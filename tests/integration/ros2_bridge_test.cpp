@@ -44,10 +44,10 @@ struct Inbox {
   }
 };
 
-// Waits until pred() holds or the timeout passes.
+// Waits until pred() holds or the timeout (scaled() under the sanitizers) passes.
 template <class Pred>
 bool eventually(Pred pred, std::chrono::milliseconds timeout) {
-  const auto end = std::chrono::steady_clock::now() + timeout;
+  const auto end = std::chrono::steady_clock::now() + scaled(timeout);
   while (!pred()) {
     if (std::chrono::steady_clock::now() > end) return false;
     std::this_thread::sleep_for(20ms);
@@ -151,7 +151,7 @@ TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) 
     geometry_msgs::msg::PoseWithCovarianceStamped reset = before;
     reset.pose().pose().position().x(before.pose().pose().position().x() + 1.0);
     const double wanted_x = reset.pose().pose().position().x();
-    ASSERT_TRUE(dds::wait_for_matched_readers({writer}, 5s));
+    ASSERT_TRUE(dds::wait_for_matched_readers({writer}, scaled(5s)));
     writer->write(&reset);
     EXPECT_TRUE(
         eventually([&] { return std::abs(poses.last().pose().pose().position().x() - wanted_x) < 0.4; }, 5s))

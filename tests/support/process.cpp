@@ -1,6 +1,7 @@
 #include "process.hpp"
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -43,13 +44,29 @@ void ChildProcess::signal(int sig) {
   if (!status_ && pid_ > 0) ::kill(pid_, sig);
 }
 
+namespace {
+
+// AddressSanitizer, LeakSanitizer and UndefinedBehaviorSanitizer reports (the build of
+// BEACONLOC_SANITIZE). A test may expect a child to fail, so its exit code alone cannot tell.
+bool has_sanitizer_report(const std::string& output) {
+  for (const char* marker : {"ERROR: AddressSanitizer", "ERROR: LeakSanitizer", ": runtime error: ",
+                             "SUMMARY: UndefinedBehaviorSanitizer"}) {
+    if (output.find(marker) != std::string::npos) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 std::optional<int> ChildProcess::wait(std::chrono::milliseconds timeout) {
-  const auto end = std::chrono::steady_clock::now() + timeout;
+  const auto end = std::chrono::steady_clock::now() + scaled(timeout);
   while (!status_) {
     int status = 0;
     const pid_t r = ::waitpid(pid_, &status, WNOHANG);
     if (r == pid_) {
       status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      const std::string output = log();
+      if (has_sanitizer_report(output)) ADD_FAILURE() << "sanitizer report in " << log_path_ << ":\n" << output;
       break;
     }
     if (std::chrono::steady_clock::now() > end) return std::nullopt;

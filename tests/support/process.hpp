@@ -7,7 +7,16 @@
 #include <string>
 #include <vector>
 
+#ifndef BEACONLOC_TEST_TIME_SCALE
+#define BEACONLOC_TEST_TIME_SCALE 1
+#endif
+
 namespace beaconloc::testing {
+
+// How much longer waits are under the sanitizers (BEACONLOC_SANITIZE: the instrumented processes
+// run a few times slower); 1 otherwise. ChildProcess::wait and run_command apply it themselves.
+constexpr int kTimeScale = BEACONLOC_TEST_TIME_SCALE;
+constexpr std::chrono::milliseconds scaled(std::chrono::milliseconds timeout) { return timeout * kTimeScale; }
 
 class ChildProcess {
  public:
@@ -19,7 +28,8 @@ class ChildProcess {
 
   pid_t pid() const { return pid_; }
   void signal(int sig);
-  // The exit code, or 128 + signal; nullopt on timeout.
+  // The exit code, or 128 + signal; nullopt on timeout (scaled() by kTimeScale). A sanitizer
+  // report in the child's output is a test failure whatever the exit code.
   std::optional<int> wait(std::chrono::milliseconds timeout);
   std::string log() const;
 
@@ -29,7 +39,7 @@ class ChildProcess {
   std::string log_path_;
 };
 
-// Runs to completion and returns (exit code, output).
+// Runs to completion and returns (exit code, output); -1 on timeout (scaled() by kTimeScale).
 std::pair<int, std::string> run_command(const std::vector<std::string>& argv,
                                         std::chrono::milliseconds timeout);
 

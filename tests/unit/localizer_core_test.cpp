@@ -8,6 +8,9 @@
 
 #include "beaconloc/core/estimator_registry.hpp"
 #include "offline_pipeline.hpp"
+#include "offline_run.hpp"
+#include "sim/scenario.hpp"
+#include "tof_decoder.hpp"
 
 namespace beaconloc {
 namespace {
@@ -55,6 +58,75 @@ TEST(LocalizerCore, IgnoresOtherRobotsWhenFilteredAndCountsThem) {
   EXPECT_EQ(core.counts().rejected("odometry.other_robot"), 1u);
   EXPECT_EQ(core.counts().rejected("range.other_robot"), 2u);
   EXPECT_EQ(core.robot_count(), 0u);
+}
+
+// A robot on the default scenario's data, localized, through its LocalizerCore.
+struct LocalizedRobot {
+  sim::Scenario scenario = sim::default_scenario();
+  LocalizerCore core{"range_ekf", [this] {
+                       EstimatorConfig c;
+                       c.receivers = scenario.receivers;
+                       return c;
+                     }()};
+  std::vector<SourceEvent> events = simulate(scenario, 2, 12.0);
+  TofDecoder decoder;
+  std::optional<LocalizerOutput> last;
+  LocalizedRobot() {
+    core.set_beacon_map(BeaconMap(scenario.beacons));
+    decoder.set_beacon_map(BeaconMap(scenario.beacons));
+  }
+  // Feeds events with stamps in [from_s, to_s), shifted by shift_ns.
+  void feed(double from_s, double to_s, StampNs shift_ns = 0) {
+    for (auto e : events) {
+      if (e.stamp_ns < s_to_ns(from_s) || e.stamp_ns >= s_to_ns(to_s)) continue;
+      if (e.kind == SourceEvent::Kind::kOdometry) {
+        e.odometry.stamp_ns += shift_ns;
+        if (auto out = core.on_odometry("r", e.odometry)) last = out;
+      } else if (e.kind == SourceEvent::Kind::kTof) {
+        e.tof.fire_stamp_ns += shift_ns;
+        if (const auto d = decoder.decode("r", e.tof); d.range) core.on_range("r", d.range->range);
+      }
+    }
+  }
+};
+
+// Silent ranges (the participant's beacon_range deadline) make the poses degraded at once; the
+// next range clears it.
+TEST(LocalizerCore, SilentRangesDegradeThePoseUntilARangeArrives) {
+  LocalizedRobot robot;
+  robot.feed(0.0, 5.0);
+  ASSERT_TRUE(robot.last);
+  EXPECT_EQ(robot.last->estimate.status, PoseStatus::kOk);
+  robot.core.on_ranges_silent("r");
+  robot.feed(5.0, 5.05);  // odometry only within 50 ms: no beacon fires in that window
+  EXPECT_EQ(robot.last->estimate.status, PoseStatus::kDegraded);
+  EXPECT_EQ(robot.core.worst_status(), PoseStatus::kDegraded);
+  robot.feed(5.05, 6.0);
+  EXPECT_EQ(robot.last->estimate.status, PoseStatus::kOk);
+}
+
+// The robot's clock steps back 30 s (a gateway restarted on a replayed clock): one sample is
+// refused as out of order, the next confirms the jump, and the robot's estimator starts over
+// from a global fix on the new time line instead of refusing every sample from then on.
+TEST(LocalizerCore, AClockThatJumpsBackRestartsTheRobotInsteadOfRefusingEverything) {
+  LocalizedRobot robot;
+  robot.feed(0.0, 6.0, s_to_ns(30.0));
+  ASSERT_TRUE(robot.last);
+  robot.decoder = TofDecoder();  // the decoder has its own time line (tested with the decoder)
+  robot.decoder.set_beacon_map(BeaconMap(robot.scenario.beacons));
+  robot.last.reset();
+  robot.feed(6.0, 12.0);
+  EXPECT_EQ(robot.core.counts().rejected("odometry.clock_jumped_back"), 1u);
+  EXPECT_EQ(robot.core.counts().rejected("odometry.out_of_order_odometry"), 1u);
+  ASSERT_TRUE(robot.last);
+  EXPECT_LT(robot.last->estimate.stamp_ns, s_to_ns(12.0));  // on the new time line
+  EXPECT_EQ(robot.last->estimate.status, PoseStatus::kOk);
+  // A sample a little out of order is refused and restarts nothing.
+  OdometrySample late = robot.events.front().odometry;
+  late.stamp_ns = robot.last->estimate.stamp_ns - 5 * kNsPerMillisecond;
+  late.wheel_base_m = 0.33;
+  EXPECT_FALSE(robot.core.on_odometry("r", late));
+  EXPECT_EQ(robot.core.counts().rejected("odometry.clock_jumped_back"), 1u);
 }
 
 }  // namespace

@@ -30,7 +30,7 @@ TEST(OfflineRun, TableGivesMeanAndSpreadOverSeeds) {
   b.heading_rms_deg = 4.0;
   a.nees_in_band_fraction = 0.9;
   b.nees_in_band_fraction = 0.7;
-  const std::string table = accuracy_table_markdown({{"s", "e", {a, b}, {}}});
+  const std::string table = accuracy_table_markdown({{"s", "e", {a, b}, {}, {}}});
   EXPECT_NE(table.find("| s | e | 2 | 0.050 +- 0.014 | 3.00 +- 1.41 | n/a | 0.80 +- 0.14 |"),
             std::string::npos)
       << table;

@@ -73,6 +73,10 @@ TEST(RangeEkf, RefusesBadInputWithATypedReason) {
   o.wheel_velocity_left_mps = 0.0;
   o.wheel_base_m = 0.0;
   EXPECT_EQ(ekf->predict(o).rejection, "invalid_wheel_base");
+  o.wheel_base_m = 0.33;
+  o.wheel_velocity_covariance(1, 1) = -1e-6;
+  EXPECT_EQ(ekf->predict(o).rejection, "invalid_odometry_covariance");
+  o.wheel_velocity_covariance(1, 1) = 0.0;
 
   RangeMeasurement r;
   r.stamp_ns = 2'000'000'000;

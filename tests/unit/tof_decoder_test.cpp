@@ -107,6 +107,28 @@ TEST(TofDecoder, CountsEveryRejectionByReason) {
   EXPECT_EQ(c.accepted(), 2u);
 }
 
+// Gaps forwards are taken (beacons go unheard for seconds). One TOF stamped far ahead (a bad
+// stamp) does not make the good TOFs after it stale for ever: the first one back on the robot's
+// time line is refused (time_jump) and the next firing confirms the return. A clock stepping
+// back is followed the same way. Each costs one firing, counted.
+TEST(TofDecoder, AOneOffStampFarAheadDoesNotStallTheDecoderAndAClockJumpBackIsFollowed) {
+  auto d = decoder_with_map();
+  std::uint64_t seq = 0;
+  auto decoded = [&](StampNs fire_ns) { return d.decode("r1", good(++seq, fire_ns)).range.has_value(); };
+  EXPECT_TRUE(decoded(5'000'000'000));
+  EXPECT_TRUE(decoded(100'000'000'000));  // 95 s ahead: a gap or a bad stamp, taken
+  EXPECT_FALSE(decoded(5'200'000'000));   // far behind it...
+  EXPECT_TRUE(decoded(5'400'000'000));    // ...and confirmed: back on the robot's time line
+  EXPECT_TRUE(decoded(60'000'000'000));   // a 55 s gap
+  EXPECT_TRUE(decoded(60'200'000'000));
+  EXPECT_FALSE(decoded(5'600'000'000));  // the old time line is gone
+  EXPECT_FALSE(decoded(1'000'000'000));  // the clock stepped back 59 s (a restarted replay)...
+  EXPECT_TRUE(decoded(1'200'000'000));   // ...confirmed
+  EXPECT_EQ(d.counts().rejected("time_jump"), 3u);
+  EXPECT_EQ(d.counts().rejected("stale"), 0u);
+  EXPECT_EQ(d.counts().accepted(), 6u);
+}
+
 TEST(TofDecoder, StalenessIsPerRobot) {
   auto d = decoder_with_map();
   ASSERT_TRUE(d.decode("r1", good(1, 9'000'000'000)).range);

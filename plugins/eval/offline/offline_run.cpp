@@ -1,7 +1,9 @@
 #include "offline_run.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -85,19 +87,43 @@ std::size_t AssociationTally::correct() const {
   return n;
 }
 
+std::vector<SourceEvent> deliver(std::vector<SourceEvent> events, const Delivery& delivery,
+                                 std::uint64_t seed) {
+  if (delivery.max_measurement_delay_ns <= 0) return events;
+  std::mt19937_64 rng(seed ^ 0x5deece66dULL);
+  std::uniform_int_distribution<StampNs> delay_ns(0, delivery.max_measurement_delay_ns);
+  std::vector<std::pair<StampNs, std::size_t>> arrival;
+  arrival.reserve(events.size());
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const bool measurement =
+        events[i].kind == SourceEvent::Kind::kTof || events[i].kind == SourceEvent::Kind::kLaserScan;
+    arrival.emplace_back(events[i].stamp_ns + (measurement ? delay_ns(rng) : 0), i);
+  }
+  std::stable_sort(arrival.begin(), arrival.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<SourceEvent> out;
+  out.reserve(events.size());
+  for (const auto& [at_ns, i] : arrival) out.push_back(std::move(events[i]));
+  return out;
+}
+
 OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64_t seed,
                                       const std::string& estimator,
-                                      const std::vector<std::string>& parameters, double settle_s) {
+                                      const std::vector<std::string>& parameters, double settle_s,
+                                      const Delivery& delivery) {
   OfflineStack stack(scenario, estimator, parse_estimator_parameters(parameters, "parameter"));
   TruthTrack truth;
   std::vector<EstimateRow> rows;
-  for (const auto& e : simulate(scenario, seed, scenario.duration_s)) {
+  for (const auto& e : deliver(simulate(scenario, seed, scenario.duration_s), delivery, seed)) {
     if (e.kind == SourceEvent::Kind::kOdometry) truth.add(e.stamp_ns, e.truth_map_base);
     if (auto pose = stack.feed("robot", e)) rows.push_back({"robot", pose->estimate, estimator});
   }
   OfflineRunResult result;
   result.poses = rows.size();
   result.associations = stack.associations;
+  result.rejections.add_rejections(stack.decoder.counts(), "decoder.");
+  result.rejections.add_rejections(stack.localizer.counts(), "localizer.");
+  result.replays = stack.localizer.replays();
   EvaluationOptions options;
   if (!rows.empty()) options.score_from_ns = rows.front().estimate.stamp_ns + s_to_ns(settle_s);
   result.metrics = evaluate(truth, rows, options);

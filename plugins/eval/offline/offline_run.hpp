@@ -51,19 +51,35 @@ struct OfflineRunResult {
   Metrics metrics;
   std::size_t poses = 0;
   AssociationTally associations;
+  RejectionCounter rejections;  // decoder.<reason> and localizer.<reason>
+  std::uint64_t replays = 0;    // late measurements fused at their stamp by rolling back
 };
+
+// How the measurements reach the localizer: in stamp order, or each TOF and scan late by a
+// uniform random delay in [0, max_measurement_delay_ns] (odometry on time), as a decoder hop and a
+// busy bus deliver them.
+struct Delivery {
+  StampNs max_measurement_delay_ns = 0;
+};
+
+// The simulated events in the order they arrive under the delivery (stable: ties keep stamp
+// order). The delays are drawn from their own generator seeded by seed.
+std::vector<SourceEvent> deliver(std::vector<SourceEvent> events, const Delivery& delivery,
+                                 std::uint64_t seed);
 
 // Scores poses from settle_s after the first one (the first global fix is not tracking).
 // parameters: NAME=VALUE items; std::invalid_argument names a bad one.
 OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64_t seed,
                                       const std::string& estimator,
-                                      const std::vector<std::string>& parameters, double settle_s = 0.0);
+                                      const std::vector<std::string>& parameters, double settle_s = 0.0,
+                                      const Delivery& delivery = {});
 
 struct AccuracyRow {
   std::string scenario;
   std::string estimator;
-  std::vector<Metrics> runs;                   // one per seed
-  std::vector<AssociationTally> associations;  // one per seed, where the ranges are anonymous
+  std::vector<Metrics> runs;                        // one per seed
+  std::vector<AssociationTally> associations;       // one per seed, where the ranges are anonymous
+  std::map<std::string, std::uint64_t> rejections;  // summed over the seeds
 };
 
 // A markdown table: mean and standard deviation over the seeds of E_p RMS, E_phi RMS, E_S mean

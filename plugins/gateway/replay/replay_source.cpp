@@ -13,6 +13,13 @@
 #include "beaconloc/core/speed_of_sound.hpp"
 
 namespace beaconloc {
+namespace {
+
+// Times the replay can stamp: within 4.6e9 s (146 years) of the recording's zero, so that a time
+// and a time minus a time of flight as long are int64 nanoseconds.
+bool stampable(double t_s) { return std::abs(t_s) <= 4.6e9; }
+
+}  // namespace
 
 CsvReader ReplaySource::open(const std::string& path, const std::vector<std::string>& columns) {
   try {
@@ -73,6 +80,10 @@ void ReplaySource::load_odometry(const std::string& path) {
       refuse("odom", csv.line(), "invalid_value", "dt_s and half_track_m must be > 0");
       continue;
     }
+    if (!stampable(t) || !stampable(t + dt)) {
+      refuse("odom", csv.line(), "invalid_value", "t_s and t_s + dt_s must lie within 4.6e9 s of 0");
+      continue;
+    }
     // (v, omega) held over [t_s, t_s + dt_s): the Odometry topic stamps the end of the interval.
     // Intervals follow each other; 1 ms of overlap is rounding in the recording's stamps.
     const StampNs end_ns = s_to_ns(t + dt);
@@ -109,6 +120,11 @@ void ReplaySource::load_ranges(const std::string& path) {
       refuse("ranges", csv.line(), "malformed_row", "not t_s, an unsigned beacon id and a finite range");
       continue;
     }
+    if (!stampable(t) || !stampable(range / c)) {
+      refuse("ranges", csv.line(), "invalid_value",
+             "t_s and the time of flight must lie within 4.6e9 s of 0");
+      continue;
+    }
     const StampNs arrival_ns = s_to_ns(t);
     if (arrival_ns < previous && notes_.size() < 20) {
       // Each row carries its own stamp: the rows are replayed in stamp order, and this is said.
@@ -142,6 +158,10 @@ void ReplaySource::load_truth(const std::string& path) {
     if (!csv.complete() || !parse_finite(csv.cell("t_s"), t) || !parse_finite(csv.cell("x_m"), x) ||
         !parse_finite(csv.cell("y_m"), y) || (truth_has_yaw_ && !parse_finite(csv.cell("yaw_rad"), yaw))) {
       refuse("gt", csv.line(), "malformed_row", "not finite t_s, x_m, y_m[, yaw_rad]");
+      continue;
+    }
+    if (!stampable(t)) {
+      refuse("gt", csv.line(), "invalid_value", "t_s must lie within 4.6e9 s of 0");
       continue;
     }
     const StampNs stamp = s_to_ns(t);

@@ -29,4 +29,13 @@ Scenario default_scenario() {
   return s;
 }
 
+bool Faults::silences(std::uint32_t beacon_id, StampNs fire_ns) const {
+  const auto dead = beacon_dies_at_ns.find(beacon_id);
+  if (dead != beacon_dies_at_ns.end() && fire_ns >= dead->second) return true;
+  for (const auto& [from_ns, to_ns] : tof_outages_ns) {
+    if (fire_ns >= from_ns && fire_ns < to_ns) return true;
+  }
+  return false;
+}
+
 }  // namespace beaconloc::sim

@@ -4,6 +4,7 @@
 // examples/scenarios/ (schema in its README) or built in (default_scenario).
 #include <array>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,6 +21,13 @@ struct EchoModel {
   double probability = 0.0;       // per firing and receiver: the first arrival is an echo
   double min_extra_path_m = 0.3;  // extra path of the echo, uniform in [min, max]
   double max_extra_path_m = 3.0;
+};
+
+// Faults injected into the world (sim/faults.hpp gives them from text).
+struct Faults {
+  std::map<std::uint32_t, StampNs> beacon_dies_at_ns;             // beacon id -> fires no more from
+  std::vector<std::pair<StampNs, StampNs>> tof_outages_ns;        // [from, to): no TOF published
+  bool silences(std::uint32_t beacon_id, StampNs fire_ns) const;  // dead beacon or outage
 };
 
 struct LaserModel {
@@ -52,6 +60,7 @@ struct Scenario {
   double temperature_c = 22.0;                   // true air temperature
   std::optional<double> reported_temperature_c;  // what beacons report; default: the truth
   EchoModel echo;
+  Faults faults;
 
   // Robot.
   ReceiverArray receivers;

@@ -19,6 +19,8 @@ class Section {
       : node_(node), path_(std::move(path)), origin_(std::move(origin)) {
     if (!node_.IsMap()) fail(path_.empty() ? "the document" : path_, "must be a mapping", node_);
     for (const auto& kv : node_) {
+      if (!kv.first.IsScalar())
+        fail(path_.empty() ? "the document" : path_, "has a key that is not a name", kv.first);
       const std::string key = kv.first.as<std::string>();
       if (!allowed.count(key)) fail(join(key), "is not a known key", kv.first);
     }
@@ -221,6 +223,9 @@ void read_trajectory(const Section& root, Scenario& sc) {
       t.fail(t.join("start_pose"), "is required with segments", root.node("trajectory"));
     sc.trajectory =
         Trajectory(vec3(t, t.node("start_pose"), t.join("start_pose")), segments, t.get<bool>("loop", false));
+    // The simulator composes a lap once per lap travelled, counted as an int: a bounded number.
+    if (sc.trajectory.loops() && sc.duration_s / sc.trajectory.period_s() > 1e6)
+      t.fail(t.join("loop"), "would repeat the segments more than 1e6 times in duration_s", t.node("loop"));
     return;
   }
   if (t.has("start_pose") || t.has("loop")) {
@@ -249,12 +254,16 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
     const double res = m.number("resolution_m", 0.1, 0.005, 10.0);
     if (!m.has("size_m")) m.fail(m.join("size_m"), "is required", root.node("map"));
     const Eigen::Vector2d size = vec2(m, m.node("size_m"), m.join("size_m"));
-    if (size.minCoeff() <= 0.0 || size.maxCoeff() / res > 20000)
-      m.fail(m.join("size_m"), "must be positive and at most 20000 cells a side", m.node("size_m"));
+    if (size.minCoeff() <= 0.0 || size.maxCoeff() / res > 20000 || (size.x() / res) * (size.y() / res) > 1e8)
+      m.fail(m.join("size_m"), "must be positive and at most 20000 cells a side, 1e8 cells in all",
+             m.node("size_m"));
     const Eigen::Vector2d origin =
         m.has("origin_m") ? vec2(m, m.node("origin_m"), m.join("origin_m")) : Eigen::Vector2d::Zero();
-    OccupancyGrid grid(origin, res, static_cast<int>(std::ceil(size.x() / res - 1e-9)),
-                       static_cast<int>(std::ceil(size.y() / res - 1e-9)));
+    const int width = static_cast<int>(std::ceil(size.x() / res - 1e-9));
+    const int height = static_cast<int>(std::ceil(size.y() / res - 1e-9));
+    if (width < 1 || height < 1)
+      m.fail(m.join("size_m"), "must be at least one cell a side", m.node("size_m"));
+    OccupancyGrid grid(origin, res, width, height);
     if (m.get<bool>("border", true)) grid.fill_border();
     auto fill = [&](const char* key, OccupancyGrid& target) {
       const YAML::Node list = m.node(key);

@@ -73,6 +73,13 @@ void SimSource::fire(StampNs fire_ns) {
     e.tof.beacon_temperature_c = scenario_.reported_temperature_c.value_or(scenario_.temperature_c);
     e.tof.sequence_number = tof_sequence_++;
     e.stamp_ns = fire_ns + s_to_ns(e.tof.tof_s);
+    // A silenced firing draws the same noise, so that a run with a dead beacon or an outage
+    // differs from the clean run of its seed by the fault alone. (Echoes draw more random
+    // numbers: with echoes=P the rest of the noise is another draw of the same statistics.)
+    if (scenario_.faults.silences(beacon_id, fire_ns)) {
+      --tof_sequence_;
+      continue;
+    }
     pending_tofs_.push(e);
   }
 }

@@ -1,5 +1,6 @@
 #include "beaconloc/core/occupancy_grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -20,13 +21,26 @@ void OccupancyGrid::set_occupied(int ix, int iy, bool occupied) {
 }
 
 void OccupancyGrid::fill_rectangle(const Eigen::Vector2d& min_m, const Eigen::Vector2d& max_m) {
-  for (int iy = 0; iy < height_; ++iy) {
-    for (int ix = 0; ix < width_; ++ix) {
-      const Eigen::Vector2d centre = origin_m_ + resolution_m_ * Eigen::Vector2d(ix + 0.5, iy + 0.5);
-      if ((centre.array() >= min_m.array()).all() && (centre.array() <= max_m.array()).all()) {
-        cells_[index(ix, iy)] = 1;
+  // Cell centres grow with the index: those inside along an axis are one run of indices. Find the
+  // runs of columns and rows, then fill those rows' runs (not every cell of the map: a scenario
+  // with many rectangles on a large map took minutes to load).
+  const auto run = [&](int count, int axis) {
+    std::pair<int, int> first_last{count, -1};
+    for (int i = 0; i < count; ++i) {
+      const double centre = origin_m_[axis] + resolution_m_ * (i + 0.5);
+      if (centre >= min_m[axis] && centre <= max_m[axis]) {
+        first_last.first = std::min(first_last.first, i);
+        first_last.second = i;
       }
     }
+    return first_last;
+  };
+  const auto [x0, x1] = run(width_, 0);
+  const auto [y0, y1] = run(height_, 1);
+  if (x0 > x1) return;
+  for (int iy = y0; iy <= y1; ++iy) {
+    std::fill(cells_.begin() + static_cast<std::ptrdiff_t>(index(x0, iy)),
+              cells_.begin() + static_cast<std::ptrdiff_t>(index(x1, iy)) + 1, std::uint8_t{1});
   }
 }
 

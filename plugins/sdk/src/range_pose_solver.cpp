@@ -77,21 +77,23 @@ Refined refine(const std::vector<RangeObservation>& obs, Pose2 pose, int max_ite
   return out;
 }
 
-}  // namespace
+// Index of the range with the largest residual in sigma at the pose, and that residual.
+std::pair<std::size_t, double> worst_residual(const std::vector<RangeObservation>& obs, const Pose2& pose) {
+  std::pair<std::size_t, double> worst{0, -1.0};
+  for (std::size_t i = 0; i < obs.size(); ++i) {
+    const double r = std::abs(obs[i].range_m - predict_range(pose, obs[i].receiver_solve_frame_m,
+                                                             obs[i].receiver_z_m, obs[i].beacon_map_m)
+                                                   .range_m) /
+                     std::sqrt(obs[i].variance_m2);
+    if (r > worst.second) worst = {i, r};
+  }
+  return worst;
+}
 
-RangePoseSolution solve_pose_from_ranges(const std::vector<RangeObservation>& observations,
-                                         const RangePoseSolverOptions& options) {
-  RangePoseSolution solution;
-  if (observations.size() < 4) {
-    solution.failure = "too_few_ranges";
-    return solution;
-  }
-  for (const auto& o : observations) {
-    if (!std::isfinite(o.range_m) || !(o.variance_m2 > 0.0)) {
-      solution.failure = "invalid_observation";
-      return solution;
-    }
-  }
+// Gauss-Newton from a grid of starts over the beacons' bounding box and evenly spread headings;
+// the converged fix of least cost.
+Refined best_of_starts(const std::vector<RangeObservation>& observations,
+                       const RangePoseSolverOptions& options) {
   Eigen::Vector2d lo = observations.front().beacon_map_m.head<2>(), hi = lo;
   for (const auto& o : observations) {
     lo = lo.cwiseMin(o.beacon_map_m.head<2>());
@@ -111,9 +113,56 @@ RangePoseSolution solve_pose_from_ranges(const std::vector<RangeObservation>& ob
       }
     }
   }
+  return best;
+}
+
+}  // namespace
+
+RangePoseSolution solve_pose_from_ranges(const std::vector<RangeObservation>& all_observations,
+                                         const RangePoseSolverOptions& options) {
+  std::vector<RangeObservation> observations = all_observations;
+  RangePoseSolution solution;
+  if (observations.size() < 4) {
+    solution.failure = "too_few_ranges";
+    return solution;
+  }
+  for (const auto& o : observations) {
+    if (!std::isfinite(o.range_m) || !(o.variance_m2 > 0.0)) {
+      solution.failure = "invalid_observation";
+      return solution;
+    }
+  }
+  Refined best = best_of_starts(observations, options);
   if (!best.converged) {
     solution.failure = "unobservable";
     return solution;
+  }
+  if (options.outlier_gate_sigma > 0.0) {
+    const auto max_outliers =
+        static_cast<std::size_t>(options.max_outlier_fraction * static_cast<double>(observations.size()));
+    for (;;) {
+      const auto [worst, sigma] = worst_residual(observations, best.pose);
+      if (sigma <= options.outlier_gate_sigma) break;
+      if (solution.outliers >= max_outliers || observations.size() <= 4) {
+        solution.failure = "too_many_outliers";
+        return solution;
+      }
+      observations.erase(observations.begin() + static_cast<std::ptrdiff_t>(worst));
+      ++solution.outliers;
+      // From where the fix was: once the worst ranges are out, it moves toward the pose.
+      const Refined r = refine(observations, best.pose, options.max_iterations);
+      if (!r.converged) {
+        solution.failure = "unobservable";
+        return solution;
+      }
+      best = r;
+    }
+    if (solution.outliers > 0) {
+      // The fix the ranges were judged by was found with the outliers in; with them out, every
+      // start again, in case they had pulled it into another basin.
+      const Refined again = best_of_starts(observations, options);
+      if (again.converged && again.cost < best.cost) best = again;
+    }
   }
   solution.weighted_residual_rms = std::sqrt(best.cost / static_cast<double>(observations.size()));
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(best.information);

@@ -53,6 +53,7 @@ class Duhl final : public Estimator {
   InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<Duhl>(*this); }
   std::size_t available_txs() const { return available_.size(); }
   // Tx estimates discarded because their own measurement contradicted them (distance_innovation_gate).
   std::uint64_t contradicted_txs() const { return contradicted_txs_; }
@@ -93,6 +94,7 @@ class UhlLast2 final : public Estimator {
   InputResult update(const RangeMeasurement& range) override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<UhlLast2>(*this); }
 
  private:
   struct Firing {

@@ -1,6 +1,7 @@
 #include "range_ekf.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -11,11 +12,18 @@
 
 namespace beaconloc {
 
+namespace {
+// Arrivals of one firing at the receivers of one robot: within the time sound takes to cross the
+// robot (0.4 m / 343 m/s = 1.2 ms), far less than the 200 ms between two firings.
+constexpr StampNs kSameFiringNs = 20 * kNsPerMillisecond;
+}  // namespace
+
 RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
   RangeEkfParameters p;
   p.nis_gate = c.parameter("nis_gate", p.nis_gate);
   p.init_window_s = c.parameter("init_window_s", p.init_window_s);
   p.init_min_beacons = static_cast<int>(c.parameter("init_min_beacons", p.init_min_beacons));
+  p.init_min_ranges = static_cast<int>(c.parameter("init_min_ranges", p.init_min_ranges));
   p.init_min_beacon_spread_m = c.parameter("init_min_beacon_spread_m", p.init_min_beacon_spread_m);
   p.max_odometry_gap_s = c.parameter("max_odometry_gap_s", p.max_odometry_gap_s);
   p.reinitialize_after_gated =
@@ -24,6 +32,7 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
   p.init_max_position_sigma_m = c.parameter("init_max_position_sigma_m", p.init_max_position_sigma_m);
   p.init_max_yaw_sigma_rad = c.parameter("init_max_yaw_sigma_rad", p.init_max_yaw_sigma_rad);
   p.init_retry_interval_s = c.parameter("init_retry_interval_s", p.init_retry_interval_s);
+  p.init_outlier_gate_sigma = c.parameter("init_outlier_gate_sigma", p.init_outlier_gate_sigma);
   return p;
 }
 
@@ -69,9 +78,9 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
   return fuse(r);
 }
 
-// The range is fused at the filter's current time (the newest odometry stamp); the pulse
-// arrived within one odometry period of it (<= 10 ms, 3.4 mm at 0.34 m/s). Fusing delayed ranges
-// at their own stamp by replaying odometry is the job of a later issue.
+// The range is fused at the filter's current time (the newest odometry stamp); pushed in stamp
+// order, the pulse arrived within one odometry period of it (<= 10 ms, 3.4 mm at 0.34 m/s). The
+// localizer pushes in stamp order however late a range arrives (core/out_of_sequence_fusion).
 InputResult RangeEkf::fuse(const RangeMeasurement& r) {
   const Beacon& beacon = *map_.find(r.beacon_id);
   const RangePrediction p = predict_range(ekf_.state(), receivers_.receivers_base_m[r.receiver_id],
@@ -120,10 +129,30 @@ void RangeEkf::try_initialize() {
       params_.init_min_beacon_spread_m * params_.init_min_beacon_spread_m) {
     return;
   }
-  last_init_attempt_ns_ = now_ns;
+  // Echoes, screened by geometry alone: two receivers d apart hearing one firing measure ranges
+  // that differ by at most d (triangle inequality); an echo's path is longer, so of a pair that
+  // differs by more, the longer range is the echo.
+  std::vector<bool> echo(window_.size(), false);
+  for (std::size_t i = 0; i < window_.size(); ++i) {
+    for (std::size_t j = i + 1; j < window_.size(); ++j) {
+      const RangeMeasurement& a = window_[i].range;
+      const RangeMeasurement& b = window_[j].range;
+      if (a.beacon_id != b.beacon_id || a.receiver_id == b.receiver_id ||
+          std::abs(a.stamp_ns - b.stamp_ns) > kSameFiringNs) {
+        continue;
+      }
+      const double baseline_m =
+          (receivers_.receivers_base_m[a.receiver_id] - receivers_.receivers_base_m[b.receiver_id]).norm();
+      if (std::abs(a.range_m - b.range_m) > baseline_m + 3.0 * std::sqrt(a.variance_m2 + b.variance_m2)) {
+        echo[a.range_m > b.range_m ? i : j] = true;
+      }
+    }
+  }
 
   std::vector<RangeObservation> observations;
-  for (const auto& b : window_) {
+  for (std::size_t k = 0; k < window_.size(); ++k) {
+    if (echo[k]) continue;
+    const BufferedRange& b = window_[k];
     // Where the receiver was, in the frame of the robot now (dead-reckoned odometry).
     const Pose2 then_in_now = between(odom_pose_, b.odom_pose_at_range);
     const double travelled_m = then_in_now.head<2>().norm();
@@ -136,7 +165,15 @@ void RangeEkf::try_initialize() {
     o.variance_m2 = b.range.variance_m2 + std::pow(0.02 * travelled_m, 2);
     observations.push_back(o);
   }
-  const RangePoseSolution fix = solve_pose_from_ranges(observations);
+  // Echoes (a reflection's longer path) in the window would pull the fix off the pose: drop the
+  // ranges the fix cannot explain (core/solvers/range_pose_solver.hpp).
+  RangePoseSolverOptions solver;
+  solver.outlier_gate_sigma = params_.init_outlier_gate_sigma;
+  // Three unknowns: with fewer than init_min_ranges ranges an echo among them fits as well as the
+  // truth does; wait for redundancy.
+  if (static_cast<int>(observations.size()) < params_.init_min_ranges) return;
+  last_init_attempt_ns_ = now_ns;
+  const RangePoseSolution fix = solve_pose_from_ranges(observations, solver);
   if (!fix.ok) return;
   if (std::sqrt(fix.covariance(0, 0) + fix.covariance(1, 1)) > params_.init_max_position_sigma_m ||
       std::sqrt(fix.covariance(2, 2)) > params_.init_max_yaw_sigma_rad) {

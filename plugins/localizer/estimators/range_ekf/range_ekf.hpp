@@ -17,6 +17,7 @@ struct RangeEkfParameters {
   double nis_gate = 10.83;     // chi-square, 1 dof, 99.9 %
   double init_window_s = 3.0;  // ranges kept for a global fix
   int init_min_beacons = 3;
+  int init_min_ranges = 8;  // ranges (after the echo screen) a global fix needs: 3 unknowns + 5
   // Beacons all on one line leave the mirror image of the pose as good a fit: a global fix
   // waits until the beacons heard spread this far across their principal axis (RMS).
   double init_min_beacon_spread_m = 0.2;
@@ -27,6 +28,9 @@ struct RangeEkfParameters {
   int reinitialize_after_gated = 15;   // 5 slots x 3 receivers refused in a row: lost
   double max_range_age_s = 0.6;        // ranges older than the newest odometry by more: stale
   double init_retry_interval_s = 0.5;  // data time between two attempts at a global fix
+  // A range of the window more than this many sigma off the global fix is dropped as an echo
+  // (up to 40 % of them); 0 keeps every range.
+  double init_outlier_gate_sigma = 4.0;
 
   static RangeEkfParameters from(const EstimatorConfig& config);
 };
@@ -41,6 +45,7 @@ class RangeEkf final : public Estimator {
   InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<RangeEkf>(*this); }
 
  private:
   struct BufferedRange {

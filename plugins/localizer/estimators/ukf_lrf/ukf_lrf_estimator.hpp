@@ -54,6 +54,7 @@ class UkfLrf final : public Estimator {
   InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<UkfLrf>(*this); }
 
  private:
   struct Motion {

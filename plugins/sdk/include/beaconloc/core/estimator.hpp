@@ -87,6 +87,9 @@ class Estimator {
   virtual std::optional<PoseEstimate> estimate() const = 0;
   // Status from data time alone (the stamps pushed so far).
   virtual PoseStatus status() const = 0;
+  // A copy of the whole state, to roll back to when a measurement arrives late
+  // (core/out_of_sequence_fusion.hpp).
+  virtual std::unique_ptr<Estimator> clone() const = 0;
 };
 
 // The checks every range-based estimator makes of a range: finite, positive, from an identified

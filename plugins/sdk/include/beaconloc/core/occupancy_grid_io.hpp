@@ -17,6 +17,11 @@ struct MapFileError : std::runtime_error {
 
 // Throws MapFileError naming the file and what is wrong with it.
 OccupancyGrid load_occupancy_grid(const std::string& yaml_path);
+// The same from memory: the YAML text and the bytes of the image it names (the name is checked,
+// not opened); yaml_origin and image_origin name them in messages.
+OccupancyGrid parse_occupancy_grid(const std::string& yaml_text, const std::string& image_bytes,
+                                   const std::string& yaml_origin = "<map yaml>",
+                                   const std::string& image_origin = "<map image>");
 // Writes yaml_path and, beside it, the PGM it names (same stem, .pgm).
 void write_occupancy_grid(const OccupancyGrid& grid, const std::string& yaml_path);
 

@@ -10,6 +10,9 @@ class RejectionCounter {
  public:
   void accept() { ++accepted_; }
   void reject(const std::string& reason) { ++rejected_[reason]; }
+  void reject(const std::string& reason, std::uint64_t count) {
+    if (count) rejected_[reason] += count;
+  }
   std::uint64_t accepted() const { return accepted_; }
   std::uint64_t rejected(const std::string& reason) const {
     auto it = rejected_.find(reason);

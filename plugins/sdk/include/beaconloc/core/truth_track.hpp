@@ -1,6 +1,7 @@
 #pragma once
 // Ground-truth poses by stamp, looked up at the stamps of estimates. Some recordings have no
 // heading: each sample says whether its yaw is known.
+#include <cstdint>
 #include <iterator>
 #include <map>
 #include <optional>
@@ -28,7 +29,9 @@ class TruthTrack {
     if (hi != samples_.end() && hi->first == stamp_ns) return hi->second;
     if (hi == samples_.end() || hi == samples_.begin()) return std::nullopt;
     auto lo = std::prev(hi);
-    if (hi->first - lo->first > max_gap_ns) return std::nullopt;
+    // hi > lo: as unsigned, their distance never overflows (stamps at both ends of the clock).
+    const std::uint64_t gap = static_cast<std::uint64_t>(hi->first) - static_cast<std::uint64_t>(lo->first);
+    if (max_gap_ns < 0 || gap > static_cast<std::uint64_t>(max_gap_ns)) return std::nullopt;
     const double f = static_cast<double>(stamp_ns - lo->first) / static_cast<double>(hi->first - lo->first);
     const Pose2& a = lo->second.pose_map_base;
     const Pose2& b = hi->second.pose_map_base;

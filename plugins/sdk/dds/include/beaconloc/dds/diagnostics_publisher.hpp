@@ -1,6 +1,7 @@
 #pragma once
 // Publishes a participant's Diagnostics once a second, and a last time when stopped. The
-// snapshot function builds the sample (it runs on the publisher's own thread).
+// snapshot function builds the sample (it runs on the publisher's own thread); the samples the
+// participant could not deserialize are added as rejections "undecodable_sample".
 #include <beaconloc.h>
 
 #include <functional>
@@ -20,6 +21,7 @@ class DiagnosticsPublisher {
   void stop();
 
  private:
+  const Participant& participant_;
   std::function<msg::Diagnostics()> snapshot_;
   eprosima::fastdds::dds::DataWriter* writer_;
   std::unique_ptr<PeriodicTask> task_;

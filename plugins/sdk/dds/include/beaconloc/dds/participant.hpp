@@ -16,10 +16,13 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "beaconloc/dds/checked_type.hpp"
 #include "beaconloc/dds/topics.hpp"
 
 namespace beaconloc::dds {
@@ -39,27 +42,70 @@ class DdsError : public std::runtime_error {
 // Loads the embedded profiles, then each extra file. Throws DdsError naming a file that fails.
 void load_qos_profiles(const std::vector<std::string>& extra_files);
 
-// Takes every valid sample a reader has and hands it to a callback; counts missed deadlines.
+// What a reader tells its participant besides samples (each member optional):
+template <class Msg>
+struct ReaderEvents {
+  std::atomic<std::uint64_t>* deadline_misses = nullptr;  // deadline QoS: an instance went quiet
+  // The instance that missed its deadline, as a sample whose key fields are set (the robot id).
+  std::function<void(const Msg& key)> on_deadline_missed;
+  std::atomic<std::uint64_t>* writers_lost = nullptr;  // liveliness QoS: a writer died or hung
+  // True from a writer's loss of liveliness until a writer is alive again (a writer that leaves
+  // cleanly is not lost).
+  std::atomic<bool>* lost_and_none_alive = nullptr;
+};
+
+// Takes every valid sample a reader has and hands it to a callback; counts missed deadlines and
+// writers that lost liveliness.
 template <class Msg>
 class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
  public:
-  SampleListener(std::function<void(const Msg&)> on_sample, std::atomic<std::uint64_t>* deadline_misses)
-      : on_sample_(std::move(on_sample)), deadline_misses_(deadline_misses) {}
+  SampleListener(std::function<void(const Msg&)> on_sample, ReaderEvents<Msg> events)
+      : on_sample_(std::move(on_sample)), events_(std::move(events)) {}
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
     Msg m;
     eprosima::fastdds::dds::SampleInfo info;
     while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-      if (info.valid_data) on_sample_(m);
+      if (!info.valid_data) continue;
+      if (events_.on_deadline_missed) {
+        // Fast DDS 2.9's DataReader::get_key_value is unsupported: keep each instance's key.
+        std::lock_guard<std::mutex> lock(keys_mutex_);
+        if (!keys_.count(info.instance_handle)) keys_.emplace(info.instance_handle, m);
+      }
+      on_sample_(m);
     }
   }
   void on_requested_deadline_missed(eprosima::fastdds::dds::DataReader*,
                                     const eprosima::fastdds::dds::RequestedDeadlineMissedStatus& s) override {
-    if (deadline_misses_) *deadline_misses_ += static_cast<std::uint64_t>(s.total_count_change);
+    if (events_.deadline_misses) *events_.deadline_misses += static_cast<std::uint64_t>(s.total_count_change);
+    if (events_.on_deadline_missed) {
+      std::optional<Msg> key;
+      {
+        std::lock_guard<std::mutex> lock(keys_mutex_);
+        const auto it = keys_.find(s.last_instance_handle);
+        if (it != keys_.end()) key = it->second;
+      }
+      if (key) events_.on_deadline_missed(*key);
+    }
+  }
+  void on_liveliness_changed(eprosima::fastdds::dds::DataReader*,
+                             const eprosima::fastdds::dds::LivelinessChangedStatus& s) override {
+    if (events_.writers_lost && s.not_alive_count_change > 0) {
+      *events_.writers_lost += static_cast<std::uint64_t>(s.not_alive_count_change);
+    }
+    if (events_.lost_and_none_alive) {
+      if (s.alive_count > 0) {
+        *events_.lost_and_none_alive = false;
+      } else if (s.not_alive_count_change > 0) {
+        *events_.lost_and_none_alive = true;
+      }
+    }
   }
 
  private:
   std::function<void(const Msg&)> on_sample_;
-  std::atomic<std::uint64_t>* deadline_misses_;
+  ReaderEvents<Msg> events_;
+  std::mutex keys_mutex_;
+  std::map<eprosima::fastdds::dds::InstanceHandle_t, Msg> keys_;  // a sample of each instance seen
 };
 
 // Waits until every writer has at least one matched reader; false on timeout.
@@ -76,7 +122,8 @@ class Participant {
   template <class PubSubType>
   eprosima::fastdds::dds::DataWriter* writer(const TopicSpec& spec,
                                              eprosima::fastdds::dds::DataWriterListener* listener = nullptr) {
-    return make_writer(topic(spec.name, new PubSubType()), spec.writer_profile, listener);
+    return make_writer(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.writer_profile,
+                       listener);
   }
   // Subscribes with the topic's reader profile; on_sample runs on the reader's thread for each
   // valid sample. The participant owns the listener; close() before what on_sample uses dies.
@@ -84,11 +131,22 @@ class Participant {
   eprosima::fastdds::dds::DataReader* subscribe(
       const TopicSpec& spec, std::function<void(const typename PubSubType::type&)> on_sample,
       std::atomic<std::uint64_t>* deadline_misses = nullptr) {
+    ReaderEvents<typename PubSubType::type> events;
+    events.deadline_misses = deadline_misses;
+    return subscribe<PubSubType>(spec, std::move(on_sample), std::move(events));
+  }
+  template <class PubSubType>
+  eprosima::fastdds::dds::DataReader* subscribe(
+      const TopicSpec& spec, std::function<void(const typename PubSubType::type&)> on_sample,
+      ReaderEvents<typename PubSubType::type> events) {
     listeners_.push_back(
-        std::make_unique<SampleListener<typename PubSubType::type>>(std::move(on_sample), deadline_misses));
-    return make_reader(topic(spec.name, new PubSubType()), spec.reader_profile, listeners_.back().get());
+        std::make_unique<SampleListener<typename PubSubType::type>>(std::move(on_sample), std::move(events)));
+    return make_reader(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.reader_profile,
+                       listeners_.back().get());
   }
   const std::string& name() const { return name_; }
+  // Samples whose payload could not be read, on any topic (Fast DDS dropped them).
+  std::uint64_t undecodable_samples() const { return undecodable_.load(); }
   // Deletes readers and writers first: call before the listeners they use are destroyed.
   void close();
 
@@ -102,6 +160,7 @@ class Participant {
                                                   eprosima::fastdds::dds::DataReaderListener* l);
 
   std::string name_;
+  std::atomic<std::uint64_t> undecodable_{0};  // counted by the types this participant registers
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;

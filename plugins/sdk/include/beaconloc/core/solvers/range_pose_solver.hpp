@@ -22,13 +22,19 @@ struct RangePoseSolverOptions {
   int position_starts_per_axis = 3;  // grid over the beacons' bounding box
   int max_iterations = 30;
   double max_residual_rms_sigma = 3.0;  // accept when the weighted residual RMS is below this
+  // Outliers (echoes: a reflection's longer path) pull a least-squares fix away from the pose.
+  // When > 0, the range with the largest residual is dropped while it exceeds this many sigma,
+  // up to max_outlier_fraction of them, and the rest solved again. 0: every range is kept.
+  double outlier_gate_sigma = 0.0;
+  double max_outlier_fraction = 0.4;
 };
 
 struct RangePoseSolution {
   bool ok = false;
   Pose2 pose = Pose2::Zero();
   Cov3 covariance = Cov3::Identity();  // (J^T R^-1 J)^-1 at the solution
-  double weighted_residual_rms = 0.0;  // residuals in units of their sigma
+  double weighted_residual_rms = 0.0;  // residuals in units of their sigma (of the ranges kept)
+  std::size_t outliers = 0;            // ranges dropped by the outlier gate
   std::string failure;                 // why ok is false
 };
 

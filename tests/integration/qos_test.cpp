@@ -1,0 +1,363 @@
+// Each QoS setting of examples/qos/topics.xml doing its job, and the faults the pipeline must
+// survive, with gateway, decoder and localizer as separate processes on loopback (a DDS domain of
+// the test's own). The gateway paces the simulation against the wall clock and stamps its samples
+// with it, so a stamp and the wall clock can be compared. Runs that kill a process use the
+// UDP-only loopback profile: a killed process cannot remove shared-memory segments.
+#include <beaconlocPubSubTypes.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <stdlib.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+#include <thread>
+
+#include "beaconloc/core/pose_error.hpp"
+#include "beaconloc/dds/wall_clock.hpp"
+#include "diagnostics_recorder.hpp"
+#include "domain_id.hpp"
+#include "pose_recorder.hpp"
+#include "process.hpp"
+
+namespace beaconloc::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+// Every BeaconRange on the bus with the wall time it arrived.
+class RangeRecorder {
+ public:
+  struct Received {
+    StampNs stamp_ns;
+    StampNs received_wall_ns;
+  };
+  explicit RangeRecorder(const dds::DdsOptions& dds) : participant_(dds, "test.range_recorder") {
+    participant_.subscribe<msg::BeaconRangePubSubType>(
+        dds::kBeaconRangeTopic, [this](const msg::BeaconRange& m) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          ranges_.push_back({m.stamp_ns(), dds::wall_clock_ns()});
+        });
+  }
+  ~RangeRecorder() { participant_.close(); }
+  std::vector<Received> ranges() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return ranges_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<Received> ranges_;
+  dds::Participant participant_;
+};
+
+std::uint64_t rejected(const msg::Diagnostics& d, const std::string& reason) {
+  for (const auto& r : d.rejected()) {
+    if (r.reason() == reason) return r.count();
+  }
+  return 0;
+}
+
+class Qos : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char dir[] = "/tmp/beaconloc-qos-XXXXXX";
+    ASSERT_NE(::mkdtemp(dir), nullptr);
+    dir_ = dir;
+    dds_.domain_id = domain_.id();
+    dds_.participant_profile = "beaconloc.loopback_udp";
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::vector<std::string> command(const std::string& sub, std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv{
+        BEACONLOC_EXECUTABLE,    sub, "--domain", std::to_string(domain_.id()), "--participant-profile",
+        dds_.participant_profile};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return argv;
+  }
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+
+  static void stop_cleanly(ChildProcess& p, const char* name) {
+    p.signal(SIGTERM);
+    const auto code = p.wait(15s);
+    ASSERT_TRUE(code) << name << " did not stop on SIGTERM";
+    EXPECT_EQ(*code, 0) << name << " log:\n" << p.log();
+  }
+  static bool running(const ChildProcess& p) { return ::kill(p.pid(), 0) == 0; }
+
+  // The stamp the gateway gave source time 0: its first odometry sample is at 10 ms.
+  static StampNs source_start_ns(const TruthTrack& truth) {
+    return truth.samples().begin()->first - 10 * kNsPerMillisecond;
+  }
+  static double position_error_m(const RecordedPose& p, const TruthTrack& truth) {
+    const auto t = truth.at(p.row.estimate.stamp_ns);
+    if (!t) return -1.0;
+    return (t->pose_map_base.head<2>() - p.row.estimate.pose_map_base.head<2>()).norm();
+  }
+
+  DomainLease domain_;
+  dds::DdsOptions dds_;
+  std::string dir_;
+};
+
+// raw_tof and beacon_range deadline (400 ms, two slots): a gateway that stops publishing TOFs
+// from 6 s to 9 s of its run (odometry goes on) is noticed by the localizer, whose poses turn
+// degraded and keep coming at the odometry rate on dead reckoning; they turn ok again once the
+// TOFs are back.
+TEST_F(Qos, SilentTofsAreNoticedWithinTwoSlotsAndTheLocalizerCoastsThenRecovers) {
+  dds_.participant_profile = "beaconloc.loopback";  // nothing is killed here: shared memory is fine
+  PoseRecorder poses(dds_);
+  DiagnosticsRecorder diagnostics(dds_);
+  ChildProcess localizer(command("localizer"), path("localizer.log"));
+  ChildProcess decoder(command("decoder"), path("decoder.log"));
+  std::this_thread::sleep_for(1s);
+  ChildProcess gateway(command("gateway", {"--duration-s", "14", "--seed", "4", "--fault", "tof_outage=6:9",
+                                           "--truth-out", path("truth.csv")}),
+                       path("gateway.log"));
+  ASSERT_TRUE(gateway.wait(60s)) << gateway.log();
+  std::this_thread::sleep_for(1500ms);  // a last diagnostics round
+  const auto latest = diagnostics.latest();
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
+
+  const auto truth = load_truth_csv(path("truth.csv"));
+  const StampNs t0 = source_start_ns(truth);
+  const StampNs outage_from = t0 + s_to_ns(6.0), outage_to = t0 + s_to_ns(9.0);
+  const auto all = poses.poses();
+  ASSERT_GT(all.size(), 500u) << localizer.log();
+  // The last firing before the outage is at 5.85 s: the deadline fires 400 ms after its range.
+  std::optional<StampNs> first_degraded;
+  std::size_t coasting = 0, ok_after = 0, degraded_after = 0;
+  double coasting_max_error_m = 0.0;
+  for (const auto& p : all) {
+    const auto& e = p.row.estimate;
+    if (e.status == PoseStatus::kDegraded && !first_degraded) first_degraded = e.stamp_ns;
+    if (e.stamp_ns >= outage_from + s_to_ns(0.6) && e.stamp_ns < outage_to) {
+      ++coasting;
+      EXPECT_EQ(e.status, PoseStatus::kDegraded) << "at " << ns_to_s(e.stamp_ns - t0) << " s";
+      coasting_max_error_m = std::max(coasting_max_error_m, position_error_m(p, truth));
+    }
+    if (e.stamp_ns >= outage_to + s_to_ns(1.0)) {
+      ++(e.status == PoseStatus::kOk ? ok_after : degraded_after);
+    }
+  }
+  ASSERT_TRUE(first_degraded) << localizer.log();
+  const double noticed_s = ns_to_s(*first_degraded - outage_from);
+  std::printf(
+      "TOF outage 6-9 s: degraded from %.3f s after the outage began (last range ~0.16 s before it), "
+      "%zu poses while coasting, max error %.3f m; after: %zu ok, %zu degraded\n",
+      noticed_s, coasting, coasting_max_error_m, ok_after, degraded_after);
+  EXPECT_GE(noticed_s, -0.15 * kTimeScale);  // not before the TOFs stopped (the pipeline's lag aside)
+  EXPECT_LE(noticed_s, 0.6 * kTimeScale);    // two slots after the last range, plus delivery
+  EXPECT_GE(coasting, 200u);                 // 2.4 s at 100 Hz: the poses kept coming
+  EXPECT_LE(coasting_max_error_m, 0.10);     // dead reckoning over 3 s
+  EXPECT_GT(ok_after, 200u);
+  EXPECT_EQ(degraded_after, 0u);
+  ASSERT_EQ(latest.count("beaconloc.decoder"), 1u);
+  ASSERT_EQ(latest.count("beaconloc.localizer.range_ekf"), 1u);
+  EXPECT_GE(latest.at("beaconloc.decoder").deadline_misses(), 1u);
+  EXPECT_GE(latest.at("beaconloc.localizer.range_ekf").deadline_misses(), 1u);
+}
+
+// Liveliness (manual by topic, asserted by the gateway every 250 ms, 1 s lease): a gateway killed with
+// SIGKILL is noticed by the decoder and the localizer, which report it in Diagnostics; a new gateway process
+// is picked up by the same decoder and localizer, which localize it again.
+TEST_F(Qos, DeadGatewayIsNoticedByLivelinessAndARestartedOneIsPickedUp) {
+  PoseRecorder poses(dds_);
+  DiagnosticsRecorder diagnostics(dds_);
+  ChildProcess localizer(command("localizer"), path("localizer.log"));
+  ChildProcess decoder(command("decoder"), path("decoder.log"));
+  std::this_thread::sleep_for(1s);
+  {
+    ChildProcess first(command("gateway", {"--duration-s", "60", "--seed", "8"}), path("gateway1.log"));
+    std::this_thread::sleep_for(scaled(5s));
+    first.signal(SIGKILL);
+    ASSERT_TRUE(first.wait(5s));
+  }
+  const auto killed = std::chrono::steady_clock::now();
+  // Lease 1 s, then the next diagnostics round (1 Hz).
+  std::map<std::string, msg::Diagnostics> latest;
+  while (std::chrono::steady_clock::now() - killed < scaled(6s)) {
+    latest = diagnostics.latest();
+    if (latest.count("beaconloc.decoder") && latest.at("beaconloc.decoder").writers_lost() > 0 &&
+        latest.count("beaconloc.localizer.range_ekf") &&
+        latest.at("beaconloc.localizer.range_ekf").writers_lost() > 0) {
+      break;
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  const double noticed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
+  ASSERT_EQ(latest.count("beaconloc.decoder"), 1u);
+  ASSERT_EQ(latest.count("beaconloc.localizer.range_ekf"), 1u);
+  const auto& dec = latest.at("beaconloc.decoder");
+  const auto& loc = latest.at("beaconloc.localizer.range_ekf");
+  std::printf("gateway killed: reported lost by decoder and localizer %.2f s later (%s / %s)\n", noticed_s,
+              dec.message().c_str(), loc.message().c_str());
+  EXPECT_GE(dec.writers_lost(), 1u);
+  EXPECT_GE(loc.writers_lost(), 1u);
+  EXPECT_EQ(dec.status(), msg::PARTICIPANT_STATUS_DEGRADED);
+  EXPECT_EQ(loc.status(), msg::PARTICIPANT_STATUS_DEGRADED);
+  EXPECT_NE(dec.message().find("gateway was lost"), std::string::npos);
+
+  const StampNs restarted_wall_ns = dds::wall_clock_ns();
+  ChildProcess second(
+      command("gateway", {"--duration-s", "12", "--seed", "9", "--truth-out", path("truth.csv")}),
+      path("gateway2.log"));
+  ASSERT_TRUE(second.wait(60s)) << second.log();
+  std::this_thread::sleep_for(1500ms);
+  EXPECT_TRUE(running(decoder) && running(localizer)) << "nobody else was restarted";
+  latest = diagnostics.latest();
+  EXPECT_EQ(latest.at("beaconloc.decoder").status(), msg::PARTICIPANT_STATUS_OK)
+      << latest.at("beaconloc.decoder").message();
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
+
+  // The new gateway's robot starts over at the start of the path: the localizer refuses the
+  // ranges that contradict its old pose, starts again from a global fix, and tracks.
+  const auto truth = load_truth_csv(path("truth.csv"));
+  PoseErrorAccumulator after;
+  std::optional<StampNs> converged;
+  for (const auto& p : poses.poses()) {
+    if (p.row.estimate.stamp_ns < restarted_wall_ns) continue;
+    const double e = position_error_m(p, truth);
+    if (e < 0) continue;
+    if (!converged && e < 0.1) converged = p.row.estimate.stamp_ns;
+    if (converged && p.row.estimate.stamp_ns > *converged + s_to_ns(1.0)) {
+      after.add(truth.at(p.row.estimate.stamp_ns)->pose_map_base, p.row.estimate.pose_map_base);
+    }
+  }
+  ASSERT_TRUE(converged) << localizer.log();
+  std::printf(
+      "restarted gateway: localized again %.2f s after it started; position RMS after %.3f m (%zu poses)\n",
+      ns_to_s(*converged - source_start_ns(truth)), after.position_rms_m(), after.samples());
+  EXPECT_GT(after.samples(), 500u);
+  EXPECT_LE(after.position_rms_m(), 0.05);
+}
+
+// raw_tof lifespan (600 ms, three slots): a decoder stopped for 1.5 s (SIGSTOP: a stall) gets,
+// when it resumes, only the TOFs still within their useful life; the older ones expired in the
+// bus and are never decoded, so never fused.
+TEST_F(Qos, TofsOlderThanTheirLifespanAreNeverDecoded) {
+  RangeRecorder ranges(dds_);
+  ChildProcess decoder(command("decoder"), path("decoder.log"));
+  std::this_thread::sleep_for(1s);
+  ChildProcess gateway(command("gateway", {"--duration-s", "10", "--seed", "3"}), path("gateway.log"));
+  std::this_thread::sleep_for(scaled(4s));
+  decoder.signal(SIGSTOP);
+  std::this_thread::sleep_for(1500ms);
+  const StampNs resumed_wall_ns = dds::wall_clock_ns();
+  decoder.signal(SIGCONT);
+  ASSERT_TRUE(gateway.wait(60s)) << gateway.log();
+  std::this_thread::sleep_for(500ms);
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
+
+  // Ranges decoded in the 300 ms after the resume: the stall's backlog.
+  double oldest_age_s = 0.0;
+  std::size_t backlog = 0;
+  for (const auto& r : ranges.ranges()) {
+    if (r.received_wall_ns < resumed_wall_ns ||
+        r.received_wall_ns > resumed_wall_ns + s_to_ns(0.3 * kTimeScale)) {
+      continue;
+    }
+    ++backlog;
+    oldest_age_s = std::max(oldest_age_s, ns_to_s(resumed_wall_ns - r.stamp_ns));
+  }
+  std::printf(
+      "decoder stalled 1.5 s: %zu ranges decoded from its backlog, the oldest %.3f s old at the resume\n",
+      backlog, oldest_age_s);
+  EXPECT_GE(backlog, 3u);              // what was still fresh was delivered (reliable)
+  EXPECT_LE(oldest_age_s, 0.6 + 0.1);  // nothing past its 600 ms lifespan (+ the TOF's own flight)
+}
+
+// odometry history (keep_last 50 = 500 ms, reliable): a localizer stalled (SIGSTOP) for 300 ms
+// at a time, longer than the 200 ms between two beacon slots, loses no 100 Hz increment: the
+// localizer counts every sequence number it never received (odometry.lost_increment), and the
+// count stays 0. Stalled for 1.5 s, three times its history, it may lose some, and counts them.
+TEST_F(Qos, OdometryHistoryCoversAStalledLocalizerAndLostIncrementsAreCounted) {
+  DiagnosticsRecorder diagnostics(dds_);
+  ChildProcess localizer(command("localizer"), path("localizer.log"));
+  ChildProcess decoder(command("decoder"), path("decoder.log"));
+  std::this_thread::sleep_for(1s);
+  ChildProcess gateway(command("gateway", {"--duration-s", "14", "--seed", "2"}), path("gateway.log"));
+  std::this_thread::sleep_for(scaled(3s));
+  for (int i = 0; i < 5; ++i) {
+    localizer.signal(SIGSTOP);
+    std::this_thread::sleep_for(300ms);
+    localizer.signal(SIGCONT);
+    std::this_thread::sleep_for(700ms);
+  }
+  std::this_thread::sleep_for(1500ms);
+  const auto after_short = diagnostics.latest();
+  localizer.signal(SIGSTOP);
+  std::this_thread::sleep_for(1500ms);
+  localizer.signal(SIGCONT);
+  ASSERT_TRUE(gateway.wait(60s)) << gateway.log();
+  std::this_thread::sleep_for(1500ms);
+  const auto after_long = diagnostics.latest();
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
+
+  ASSERT_EQ(after_short.count("beaconloc.localizer.range_ekf"), 1u);
+  const auto& short_stalls = after_short.at("beaconloc.localizer.range_ekf");
+  const auto& long_stall = after_long.at("beaconloc.localizer.range_ekf");
+  const std::uint64_t lost_short = rejected(short_stalls, "odometry.lost_increment");
+  const std::uint64_t lost_long = rejected(long_stall, "odometry.lost_increment");
+  std::printf(
+      "localizer stalled 5 x 300 ms: %llu increments lost, %llu samples accepted; then 1.5 s: %llu lost\n",
+      static_cast<unsigned long long>(lost_short), static_cast<unsigned long long>(short_stalls.accepted()),
+      static_cast<unsigned long long>(lost_long));
+  EXPECT_EQ(lost_short, 0u);
+  EXPECT_EQ(rejected(short_stalls, "odometry.odometry_gap"), 0u);
+  EXPECT_GT(short_stalls.accepted(), 800u);  // > 8 s of 100 Hz odometry
+  // 1.5 s is three times the history: what the bus could not hold is counted, not hidden.
+  EXPECT_LE(lost_long, 150u);
+  EXPECT_GT(long_stall.accepted(), short_stalls.accepted() + 300u);  // it caught up
+}
+
+// A localizer killed mid-run (SIGKILL) and started again has no prior pose: it finds the robot
+// from the beacons alone (a global fix over its first ranges) within 2 s of its start.
+TEST_F(Qos, KilledLocalizerRestartedMidRunReconvergesFromBeaconsAlone) {
+  PoseRecorder poses(dds_);
+  ChildProcess decoder(command("decoder"), path("decoder.log"));
+  std::optional<ChildProcess> localizer;
+  localizer.emplace(command("localizer"), path("localizer1.log"));
+  std::this_thread::sleep_for(1s);
+  ChildProcess gateway(
+      command("gateway", {"--duration-s", "16", "--seed", "6", "--truth-out", path("truth.csv")}),
+      path("gateway.log"));
+  std::this_thread::sleep_for(scaled(6s));
+  localizer->signal(SIGKILL);
+  ASSERT_TRUE(localizer->wait(5s));
+  const StampNs restarted_wall_ns = dds::wall_clock_ns();
+  localizer.emplace(command("localizer"), path("localizer2.log"));
+  ASSERT_TRUE(gateway.wait(60s)) << gateway.log();
+  std::this_thread::sleep_for(500ms);
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(*localizer, "localizer"));
+
+  const auto truth = load_truth_csv(path("truth.csv"));
+  std::optional<StampNs> first_pose, converged;
+  PoseErrorAccumulator after;
+  for (const auto& p : poses.poses()) {
+    if (p.row.estimate.stamp_ns < restarted_wall_ns) continue;
+    if (!first_pose) first_pose = p.row.estimate.stamp_ns;
+    const double e = position_error_m(p, truth);
+    if (!converged && e >= 0 && e < 0.1 && p.row.estimate.status == PoseStatus::kOk) {
+      converged = p.row.estimate.stamp_ns;
+    }
+    if (converged) after.add(truth.at(p.row.estimate.stamp_ns)->pose_map_base, p.row.estimate.pose_map_base);
+  }
+  ASSERT_TRUE(first_pose && converged) << localizer->log();
+  const double reconverged_s = ns_to_s(*converged - restarted_wall_ns);
+  std::printf(
+      "localizer restarted: first pose %.2f s, within 0.1 m %.2f s after its start; RMS after %.3f m\n",
+      ns_to_s(*first_pose - restarted_wall_ns), reconverged_s, after.position_rms_m());
+  EXPECT_LE(reconverged_s, 2.0 * kTimeScale);  // the 2 s, in a Release build
+  EXPECT_LE(after.position_rms_m(), 0.05);
+}
+
+}  // namespace
+}  // namespace beaconloc::testing
