@@ -5,7 +5,11 @@
 #    multi-process integration test (the Cyclone DDS peer included) with the runtime settings of
 #    scripts/sanitizers.env; any sanitizer report fails the run. Not Run.ReplaysTheSharedRecordings
 #    (only where ../shared/datasets is; the full recordings take many minutes under ASan): the
-#    30 s fixture of Run.ReplaysTheTucFixture takes the same code path.
+#    30 s fixture of Run.ReplaysTheTucFixture takes the same code path. Not integration.Qos.*:
+#    they measure wall-clock behaviour (a gateway paced in real time, SIGSTOP stalls, a restart
+#    within 2 s) that instrumented processes cannot keep up with (in the first CI run 4 of 5
+#    missed their timings under ASan; none reported a sanitizer finding). Release runs them; the
+#    code they exercise runs under the sanitizers in integration.BadInput.* and Pipeline.*.
 # 2. build/release: every test (unit, multi-process integration on loopback, CLI) and the
 #    accuracy tests over many seeds, which stay Release-only (too slow under the sanitizers).
 # 3. build/fuzz: see below.
@@ -16,7 +20,8 @@ bash scripts/build.sh Asan
   set -a
   . scripts/sanitizers.env
   set +a
-  ctest --test-dir build/asan -R '^(unit|integration)\.' -E '^integration\.Run\.ReplaysTheSharedRecordings$' \
+  ctest --test-dir build/asan -R '^(unit|integration)\.' \
+    -E '^integration\.(Run\.ReplaysTheSharedRecordings|Qos\..*)$' \
     -j 2 --output-on-failure
 )
 bash scripts/build.sh Release
