@@ -78,7 +78,7 @@ TEST(Cli, ParticipantsStopCleanlyOnSigintAndSigterm) {
     for (const char* sub : {"decoder", "localizer"}) {
       ChildProcess p({BEACONLOC_EXECUTABLE, sub, "--domain", std::to_string(domain.id())},
                      "/tmp/beaconloc-cli-signal.log");
-      std::this_thread::sleep_for(500ms);
+      std::this_thread::sleep_for(scaled(500ms));  // past its start-up (slower under the sanitizers)
       p.signal(sig);
       const auto code = p.wait(10s);
       ASSERT_TRUE(code) << sub << " ignored signal " << sig;

@@ -118,7 +118,9 @@ TEST_F(Run, OneProcessPerParticipant) {
 // reach the UKF over the topics, the map as a map_server file named on the localizer's command
 // line (written from the scenario), the start pose as the paper's hand placement.
 TEST_F(Run, UkfFusesLaserAndAnonymousBeaconsAcrossProcesses) {
-  const auto [code, out] = beaconloc({"run", "--processes", "--speed", "4", "--duration-s", "20",
+  // Four times real time; under the sanitizers, as much slower as the instrumented processes are.
+  const std::string speed = std::to_string(4.0 / kTimeScale);
+  const auto [code, out] = beaconloc({"run", "--processes", "--speed", speed, "--duration-s", "20",
                                       "--scenario", kSource + "/examples/scenarios/seed001_classroom.yaml",
                                       "--estimator", "ukf_lrf", "--out", dir_});
   ASSERT_EQ(code, 0) << out;
