@@ -1,103 +1,151 @@
-// Cost of the seed 000 DUHL estimator with ten Txs in its available set (trajectory 3 has ten):
-//  - BM_DuhlOdometryStep: a 100 Hz step without a correction (eq. 14, 16, and eq. 23-24 for
-//    every Tx);
-//  - BM_DuhlStepWithCorrection: a 100 Hz step with the 5 Hz correction, as every twentieth step
-//    runs it: a Tx heard by the three receivers (eq. 25-27), then at the odometry step the UHL on
-//    all ten Txs, R of eq. 21 and the EKF update of eq. 17-20;
-//  - BM_UhlSolveTenTxs: the UHL alone.
+// Cost of the seed 000 DUHL estimator (duhl) and of its UHL, with 6 and with 10 Txs in the
+// available set T_A, on the simulator's inputs: the built-in scenario (six Txs at z_T = 2.011 m,
+// the setup of trajectories 1-2) and the same loop under ten Txs at z_T = 1.887 m (duhl_scenario),
+// both with sigma_dd = 0.01 m and 100 Hz odometry with k_v = 4e-4 m. Each benchmark starts from the
+// estimator as it was at a moment of the run (after 10 s) with that many Txs available, and times
+// the inputs that came next, on a fresh copy each iteration:
+//  - BM_Duhl_Predict/N: a 100 Hz odometry step without a correction (eq. 14, 16, and eq. 23-24
+//    and the discard test of eq. 31-32 for every Tx);
+//  - BM_Duhl_RangeUpdate/N: the three ranges of one firing (eq. 25-27, one scalar update per
+//    receiver), the UHL not yet run;
+//  - BM_Duhl_Step/N: a full DUHL step: those three ranges, then the odometry step that predicts
+//    (as above) and corrects: the UHL on the N Txs' distances (Table I), R of eq. 21 through the
+//    UHL's Jacobian, the EKF update of eq. 17-20. The correction alone is Step - Predict;
+//  - BM_Uhl/N: the UHL alone (solve_uhl, Table I: DM heading eq. 4-9, DM position eq. 10, IMR
+//    multilateration eq. 11), no EKF, on the distances from the true pose to the N Txs with
+//    sigma_dd = 0.01 m noise.
 // The paper's Table III: 0.55-0.97 ms per step on a 2.66 GHz laptop, 0.97 ms for trajectory 3.
 #include <benchmark/benchmark.h>
 
+#include <map>
+#include <random>
 #include <stdexcept>
 
 #include "beaconloc/core/models/range_model.hpp"
 #include "duhl/duhl_estimator.hpp"
-#include "exact_ranges.hpp"
+#include "estimator_bench.hpp"
 
 namespace beaconloc {
 namespace {
 
-constexpr StampNs kOdometryPeriodNs = 10'000'000;
+using bench::Input;
 
-// A robot standing under a 5 x 2 grid of Txs at z_T = 1.887 m (seed 000 trajectory 3), every
-// Tx's distances known, so that all ten stay available.
-class TenTxRobot {
- public:
-  TenTxRobot() : duhl_(config()) {
-    std::vector<Beacon> beacons;
-    for (std::uint32_t i = 0; i < 10; ++i) {
-      beacons.push_back({i + 1, {1.2 * (i % 5), 1.8 * (i / 5), 1.887}});
-    }
-    map_ = BeaconMap(beacons);
-    duhl_.set_beacon_map(map_);
-    for (std::uint32_t id = 1; id <= 10; ++id) {
-      hear(id);
-      odometry_step();
-    }
-    if (duhl_.available_txs() != 10 || !duhl_.estimate()) throw std::logic_error("setup: ten Txs expected");
+// The scenario with n Txs: 6, the built-in one (seed 000 trajectories 1-2: a 3 x 2 grid at
+// z_T = 2.011 m over a 2 m x 1.2 m loop). 10: the same loop under a 5 x 2 grid at trajectory 3's
+// z_T = 1.887 m, 1.2 m apart, so that all ten stay in T_A (on trajectory 3's own 8.8 m hall the
+// robot hears at most a few of its ten Txs at a time).
+sim::Scenario duhl_scenario(int n) {
+  sim::Scenario s = sim::default_scenario();
+  if (n == 6) return s;
+  if (n != 10) throw std::invalid_argument("duhl benchmarks: 6 or 10 Txs");
+  s.beacons.clear();
+  s.firing_order.clear();
+  for (std::uint32_t i = 0; i < 10; ++i) {
+    s.beacons.push_back({i + 1, {-0.9 + 1.2 * (i % 5), -0.3 + 1.8 * (i / 5), 1.887}, 0});
+    s.firing_order.push_back(i + 1);
   }
-  void odometry_step() {
-    stamp_ns_ += kOdometryPeriodNs;
-    OdometrySample o;
-    o.stamp_ns = stamp_ns_;
-    o.wheel_base_m = 0.33;
-    duhl_.predict(o);
-  }
-  void hear(std::uint32_t beacon_id) {
-    for (const RangeMeasurement& r :
-         test_support::exact_ranges(truth_, receivers_, *map_.find(beacon_id), stamp_ns_)) {
-      duhl_.update(r);
-    }
-  }
-  std::size_t available_txs() const { return duhl_.available_txs(); }
+  return s;
+}
 
- private:
-  static EstimatorConfig config() {
-    EstimatorConfig c;
-    c.receivers = ReceiverArray::on_circle(0.19, 3);
-    return c;
-  }
-  ReceiverArray receivers_ = ReceiverArray::on_circle(0.19, 3);
-  duhl::Duhl duhl_;
-  BeaconMap map_;
-  Pose2 truth_{2.3, 0.8, 0.4};
-  StampNs stamp_ns_ = 0;
+std::size_t available(const Estimator& e) { return dynamic_cast<const duhl::Duhl&>(e).available_txs(); }
+
+double trace(const Estimator& e) { return e.estimate() ? e.estimate()->covariance.trace() : 0.0; }
+
+struct DuhlScene {
+  bench::Snapshot predict;  // the next input is odometry alone
+  bench::Snapshot step;     // the next inputs: one firing heard by the three receivers, then odometry
+  sim::Scenario scenario;
 };
 
-void BM_DuhlOdometryStep(benchmark::State& state) {
-  TenTxRobot robot;
-  for (auto _ : state) robot.odometry_step();
-  state.counters["txs"] = static_cast<double>(robot.available_txs());
+// One scene per Tx count, built on first use (the simulated runs take a moment).
+const DuhlScene& scene(int n) {
+  static std::map<int, DuhlScene> scenes;
+  auto it = scenes.find(n);
+  if (it != scenes.end()) return it->second;
+  DuhlScene s;
+  s.scenario = duhl_scenario(n);
+  const auto inputs = bench::simulated_inputs(s.scenario, 1, 60.0);
+  const EstimatorConfig config = bench::config_for(s.scenario);
+  const BeaconMap map(s.scenario.beacons);
+  const std::size_t txs = static_cast<std::size_t>(n);
+  s.predict = bench::find_snapshot(
+      "duhl", config, map, inputs, 10.0,
+      [&](const Estimator& e, const std::vector<Input>& in, std::size_t k) {
+        std::optional<std::vector<Input>> step = bench::next_step(in, k);
+        if (in[k].kind != Input::Kind::kOdometry || !e.estimate() || available(e) != txs || step->size() != 1)
+          step.reset();
+        return step;
+      });
+  s.step = bench::find_snapshot(
+      "duhl", config, map, inputs, 10.0,
+      [&](const Estimator& e, const std::vector<Input>& in,
+          std::size_t k) -> std::optional<std::vector<Input>> {
+        const std::vector<Input> step = bench::next_step(in, k);
+        if (in[k].kind != Input::Kind::kOdometry || !e.estimate() || available(e) != txs ||
+            step.size() != 4 || bench::count(step, Input::Kind::kRange) != 3 ||
+            step[0].range.beacon_id != step[2].range.beacon_id)
+          return std::nullopt;
+        // The correction applied (not gated), on the N Txs.
+        auto predicted = e.clone(), corrected = e.clone();
+        predicted->predict(step.back().odometry);
+        for (const Input& input : step) bench::push(*corrected, input);
+        if (available(*corrected) != txs || !(trace(*corrected) < trace(*predicted))) return std::nullopt;
+        return step;
+      });
+  bench::require_accepted(s.predict, "BM_Duhl_Predict");
+  bench::require_accepted(s.step, "BM_Duhl_Step");
+  return scenes.emplace(n, std::move(s)).first->second;
 }
-BENCHMARK(BM_DuhlOdometryStep);
 
-void BM_DuhlStepWithCorrection(benchmark::State& state) {
-  TenTxRobot robot;
-  std::uint32_t next = 1;
-  for (auto _ : state) {
-    robot.hear(next);
-    robot.odometry_step();  // runs the UHL and the EKF correction
-    next = next % 10 + 1;
-  }
-  state.counters["txs"] = static_cast<double>(robot.available_txs());
+void BM_Duhl_Predict(benchmark::State& state) {
+  const DuhlScene& s = scene(static_cast<int>(state.range(0)));
+  bench::time_step(state, s.predict);
+  state.counters["txs"] = static_cast<double>(available(*s.predict.estimator));
 }
-BENCHMARK(BM_DuhlStepWithCorrection);
+BENCHMARK(BM_Duhl_Predict)->Arg(6)->Arg(10);
 
-// The UHL alone on the ten Txs (Table I: DM heading, IMR position).
-void BM_UhlSolveTenTxs(benchmark::State& state) {
+void BM_Duhl_RangeUpdate(benchmark::State& state) {
+  const DuhlScene& s = scene(static_cast<int>(state.range(0)));
+  bench::Snapshot ranges{
+      s.step.estimator->clone(), {s.step.step.begin(), s.step.step.end() - 1}, s.step.truth};
+  bench::time_step(state, ranges);
+  state.counters["txs"] = static_cast<double>(available(*s.step.estimator));
+}
+BENCHMARK(BM_Duhl_RangeUpdate)->Arg(6)->Arg(10);
+
+void BM_Duhl_Step(benchmark::State& state) {
+  const DuhlScene& s = scene(static_cast<int>(state.range(0)));
+  bench::time_step(state, s.step);
+  state.counters["txs"] = static_cast<double>(available(*s.step.estimator));
+}
+BENCHMARK(BM_Duhl_Step)->Arg(6)->Arg(10);
+
+// The UHL alone on the scenario's N Txs, from the true pose at the Step snapshot.
+void BM_Uhl(benchmark::State& state) {
+  const DuhlScene& s = scene(static_cast<int>(state.range(0)));
+  const ReceiverArray& receivers = s.scenario.receivers;
+  std::mt19937_64 rng(1);
+  std::normal_distribution<double> noise(0.0, s.scenario.range_sigma_m);
   std::vector<duhl::TxDistances> txs;
-  const Pose2 truth(2.3, 0.8, 0.4);
-  const ReceiverArray receivers = ReceiverArray::on_circle(0.19, 3);
-  for (std::uint32_t i = 0; i < 10; ++i) {
+  for (const Beacon& b : s.scenario.beacons) {
     duhl::TxDistances t;
-    t.tx_map_m = {1.2 * (i % 5), 1.8 * (i / 5), 1.887};
-    for (int l = 0; l < 3; ++l)
-      t.distances_m(l) = predict_range(truth, receivers.receivers_base_m[l], 0.0, t.tx_map_m).range_m;
+    t.tx_map_m = b.position_map_m;
+    for (int l = 0; l < 3; ++l) {
+      t.distances_m(l) = predict_range(s.step.truth, receivers.receivers_base_m[l],
+                                       receivers.receiver_height_m, b.position_map_m)
+                             .range_m +
+                         noise(rng);
+    }
     txs.push_back(t);
   }
-  for (auto _ : state) benchmark::DoNotOptimize(duhl::solve_uhl(txs));
+  duhl::UhlOptions options;
+  options.receiver_radius_m = receivers.receivers_base_m[0].norm();
+  options.receiver_height_m = receivers.receiver_height_m;
+  if (!duhl::solve_uhl(txs, options).ok) throw std::logic_error("BM_Uhl: no UHL solution");
+  for (auto _ : state) benchmark::DoNotOptimize(duhl::solve_uhl(txs, options));
+  state.counters["txs"] = static_cast<double>(txs.size());
 }
-BENCHMARK(BM_UhlSolveTenTxs);
+BENCHMARK(BM_Uhl)->Arg(6)->Arg(10);
 
 }  // namespace
 }  // namespace beaconloc

@@ -1,68 +1,141 @@
-// Cost of one fused update of the seed 001 UKF (ukf_lrf) in the paper's setup: the 28-element
-// augmented state (pose, two odometry noises, four beacon ranges, 19 laser beams), 57 sigma
-// points, every one ray-cast for the 19 beams on the classroom's 10 cm grid; the prediction of
-// eq. 9-13, the association of Table 2 and the correction of eq. 15-22. The paper: 8 ms per
-// iteration (MATLAB, i7-3770 at 3.4 GHz, Sec. 4.1).
+// Cost of the seed 001 UKF (ukf_lrf, fusion mode) on the simulator's inputs of the classroom
+// scenario (four anonymous ceiling beacons, a 19-beam laser every 22 ms, odometry every 22 ms,
+// the 10 cm occupancy grid), from the estimator as it was at a moment of the run after 10 s, on
+// a fresh copy each iteration:
+//  - BM_UkfLrf_Predict: an odometry step with no measurement held: the augmented state of the
+//    pose and the two velocity noises (L = 5, 11 sigma points) through eq. 9-13;
+//  - BM_UkfLrf_LaserUpdate/19: a scan of 19 usable beams fused at the filter's time, as the
+//    simulator delivers it (the scan right after the odometry of its stamp): no motion terms,
+//    L = 3 + 19, 45 sigma points, every pose-moving one ray cast for the 19 beams (eq. 15-22);
+//  - BM_UkfLrf_FusedUpdate/beams:19/ranges:R: one iteration of Table 1 with everything at once,
+//    as the paper runs it: R anonymous beacon ranges and the 19-beam scan held, then the odometry
+//    step that predicts (eq. 9-13), associates each range (Table 2) and corrects (eq. 15-22). L =
+//    3 + 2 + R + 19; R = 4 is the paper's 28-element state (57 sigma points). R = 0 is the
+//    simulator's scan; R = 1 adds the range the simulator delivered in that step; R = 4 takes the
+//    four beacons' ranges from the true pose with the scenario's range noise.
+// The paper: 8 ms per iteration (MATLAB, i7-3770 at 3.4 GHz, Sec. 4.1).
 #include <benchmark/benchmark.h>
 
-#include <memory>
+#include <cmath>
+#include <random>
 #include <stdexcept>
-#include <string>
 
-#include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/models/range_model.hpp"
-#include "sim/scenario_yaml.hpp"
-#include "ukf_lrf/laser_model.hpp"
+#include "estimator_bench.hpp"
 
 namespace beaconloc {
 namespace {
 
-void BM_UkfLrfFusedUpdate(benchmark::State& state) {
-  const sim::Scenario scenario = sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) +
-                                                         "/examples/scenarios/seed001_classroom.yaml");
+using bench::Input;
+
+struct UkfScene {
+  sim::Scenario scenario;
+  std::vector<Input> inputs;
   EstimatorConfig config;
-  config.receivers = scenario.receivers;
-  config.occupancy_grid = std::make_shared<const OccupancyGrid>(*scenario.map);
-  const Pose2 pose = scenario.trajectory.pose_at(0.0);
-  config.initial_pose = pose;
-  auto ukf = EstimatorRegistry::instance().create("ukf_lrf", config);
-  const BeaconMap map(scenario.beacons);
-  ukf->set_beacon_map(map);
+  BeaconMap map;
+};
 
-  LaserScanSample scan;
-  scan.angle_min_rad = static_cast<float>(-M_PI / 2);
-  scan.angle_increment_rad = static_cast<float>(M_PI / 18);
-  scan.range_min_m = 0.0f;
-  scan.range_max_m = 80.0f;
-  ukf_lrf::LaserBeams beams;
-  for (int i = 0; i < 19; ++i) beams.add_beam(scan.angle_min_rad + static_cast<float>(i) * scan.angle_increment_rad);
-  double expected[19];
-  ukf_lrf::expected_laser_ranges(*scenario.map, pose, beams, expected);
-  for (double r : expected) scan.ranges_m.push_back(static_cast<float>(r));
-
-  StampNs stamp_ns = 0;
-  OdometrySample o;
-  o.wheel_base_m = scenario.wheel_base_m;
-  o.stamp_ns = stamp_ns;
-  ukf->predict(o);  // the time line's anchor
-  for (auto _ : state) {
-    stamp_ns += 22'000'000;
-    for (const Beacon& b : map.beacons()) {
-      RangeMeasurement r;
-      r.stamp_ns = stamp_ns;
-      r.range_m = predict_range(pose, scenario.receivers.receivers_base_m[0],
-                                scenario.receivers.receiver_height_m, b.position_map_m)
-                      .range_m;
-      r.variance_m2 = 0.16;
-      ukf->update(r);
-    }
-    scan.stamp_ns = stamp_ns;
-    ukf->update_laser(scan);
-    o.stamp_ns = stamp_ns;
-    if (!ukf->predict(o).accepted) throw std::logic_error("the fused update was refused");
-  }
+const UkfScene& ukf_scene() {
+  static const UkfScene scene = [] {
+    UkfScene s;
+    s.scenario = bench::scenario_file("seed001_classroom.yaml");
+    s.inputs = bench::simulated_inputs(s.scenario, 1, 30.0);
+    s.config = bench::config_for(s.scenario);
+    s.map = BeaconMap(s.scenario.beacons);
+    return s;
+  }();
+  return scene;
 }
-BENCHMARK(BM_UkfLrfFusedUpdate);
+
+std::size_t usable_beams(const LaserScanSample& scan) {
+  std::size_t n = 0;
+  for (float r : scan.ranges_m) n += std::isfinite(r) && r > scan.range_min_m && r < scan.range_max_m ? 1 : 0;
+  return n;
+}
+
+void BM_UkfLrf_Predict(benchmark::State& state) {
+  const UkfScene& u = ukf_scene();
+  static const bench::Snapshot snapshot =
+      bench::find_snapshot("ukf_lrf", u.config, u.map, u.inputs, 10.0,
+                           [](const Estimator&, const std::vector<Input>& in, std::size_t k) {
+                             std::optional<std::vector<Input>> step = bench::next_step(in, k);
+                             if (in[k].kind != Input::Kind::kScan || step->size() != 1) step.reset();
+                             return step;
+                           });
+  bench::require_accepted(snapshot, "BM_UkfLrf_Predict");
+  bench::time_step(state, snapshot);
+}
+BENCHMARK(BM_UkfLrf_Predict);
+
+void BM_UkfLrf_LaserUpdate(benchmark::State& state) {
+  const UkfScene& u = ukf_scene();
+  const std::size_t beams = static_cast<std::size_t>(state.range(0));
+  const bench::Snapshot snapshot = bench::find_snapshot(
+      "ukf_lrf", u.config, u.map, u.inputs, 10.0,
+      [&](const Estimator&, const std::vector<Input>& in,
+          std::size_t k) -> std::optional<std::vector<Input>> {
+        if (in[k].kind != Input::Kind::kOdometry || k + 1 >= in.size() ||
+            in[k + 1].kind != Input::Kind::kScan || usable_beams(in[k + 1].scan) != beams)
+          return std::nullopt;
+        return std::vector<Input>{in[k + 1]};
+      });
+  bench::require_accepted(snapshot, "BM_UkfLrf_LaserUpdate");
+  bench::time_step(state, snapshot);
+  state.counters["beams"] = static_cast<double>(beams);
+}
+BENCHMARK(BM_UkfLrf_LaserUpdate)->Arg(19);
+
+void BM_UkfLrf_FusedUpdate(benchmark::State& state) {
+  const UkfScene& u = ukf_scene();
+  const std::size_t beams = static_cast<std::size_t>(state.range(0));
+  const int ranges = static_cast<int>(state.range(1));
+  const bench::Snapshot snapshot =
+      bench::find_snapshot("ukf_lrf", u.config, u.map, u.inputs, 10.0,
+                           [&](const Estimator&, const std::vector<Input>& in,
+                               std::size_t k) -> std::optional<std::vector<Input>> {
+                             // Right after a scan was fused; the next odometry step's scan follows that
+                             // odometry.
+                             if (in[k].kind != Input::Kind::kScan) return std::nullopt;
+                             std::vector<Input> step = bench::next_step(in, k);
+                             const std::size_t next = k + step.size() + 1;
+                             if (step.empty() || next >= in.size() || in[next].kind != Input::Kind::kScan ||
+                                 usable_beams(in[next].scan) != beams)
+                               return std::nullopt;
+                             const std::size_t sim_ranges = bench::count(step, Input::Kind::kRange);
+                             if (sim_ranges != (ranges == 1 ? 1u : 0u) || step.size() != sim_ranges + 1)
+                               return std::nullopt;
+                             const Input odometry = step.back();
+                             step.pop_back();
+                             if (ranges == 4) {
+                               // The four beacons' ranges at the true pose of the odometry stamp, with the
+                               // range noise.
+                               std::mt19937_64 rng(1);
+                               std::normal_distribution<double> noise(0.0, u.scenario.range_sigma_m);
+                               const ReceiverArray& rx = u.scenario.receivers;
+                               for (const Beacon& b : u.scenario.beacons) {
+                                 Input r;
+                                 r.kind = Input::Kind::kRange;
+                                 r.stamp_ns = odometry.stamp_ns;
+                                 r.range.stamp_ns = odometry.stamp_ns;
+                                 r.range.receiver_id = 0;
+                                 r.range.range_m = predict_range(odometry.truth, rx.receivers_base_m[0],
+                                                                 rx.receiver_height_m, b.position_map_m)
+                                                       .range_m +
+                                                   noise(rng);
+                                 r.range.variance_m2 = u.scenario.range_sigma_m * u.scenario.range_sigma_m;
+                                 step.push_back(r);
+                               }
+                             }
+                             step.push_back(in[next]);  // the scan, held (stamped after the filter's time)
+                             step.push_back(odometry);  // the step that fuses it all
+                             return step;
+                           });
+  bench::require_accepted(snapshot, "BM_UkfLrf_FusedUpdate");
+  bench::time_step(state, snapshot);
+  state.counters["beams"] = static_cast<double>(beams);
+  state.counters["ranges"] = static_cast<double>(ranges);
+}
+BENCHMARK(BM_UkfLrf_FusedUpdate)->ArgNames({"beams", "ranges"})->Args({19, 0})->Args({19, 1})->Args({19, 4});
 
 }  // namespace
 }  // namespace beaconloc

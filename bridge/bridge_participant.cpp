@@ -130,19 +130,16 @@ void BridgeParticipant::on_pose(const msg::PoseEstimate& m) {
   auto odometry =
       to_ros_odometry(e, odom_.v_mps(), odom_.omega_radps(), options_.map_frame, options_.base_frame);
   odometry_out_writer_->write(&odometry);
-  if (pending_transforms_.size() >= 100) {  // 1 s at 100 Hz without odometry: give the oldest up
-    pending_transforms_.pop_front();
+  if (pending_transforms_.add(e) == PendingTransforms::Added::kQueuedDroppedOldest) {
     counts_.reject("pose.no_odometry_at_stamp");  // beacon_pose went out; map -> odom could not
   }
-  pending_transforms_.push_back(e);
   publish_pending_transforms();
 }
 
 void BridgeParticipant::publish_pending_transforms() {
   const auto latest = odom_.latest_stamp_ns();
-  while (!pending_transforms_.empty() && latest && pending_transforms_.front().stamp_ns <= *latest) {
-    const PoseEstimate e = pending_transforms_.front();
-    pending_transforms_.pop_front();
+  if (!latest) return;
+  for (const PoseEstimate& e : pending_transforms_.take_reached(*latest)) {
     if (const auto map_odom = odom_.pose_map_odom(e.stamp_ns, e.pose_map_base)) {
       tf2_msgs::msg::TFMessage tf;
       tf.transforms().push_back(to_transform(e.stamp_ns, *map_odom, options_.map_frame, options_.odom_frame));
@@ -154,6 +151,7 @@ void BridgeParticipant::publish_pending_transforms() {
                                                options_.odom_frame, options_.base_frame));
       }
       tf_writer_->write(&tf);
+      pending_transforms_.published(e.stamp_ns);
       counts_.accept();
     } else {
       counts_.reject("pose.older_than_the_odometry_history");

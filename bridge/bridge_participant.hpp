@@ -22,6 +22,7 @@
 #include "beaconloc/dds/diagnostics_publisher.hpp"
 #include "beaconloc/dds/participant.hpp"
 #include "odom_frame.hpp"
+#include "pending_transforms.hpp"
 #include "ros2_types.hpp"
 
 namespace beaconloc::bridge {
@@ -70,7 +71,7 @@ class BridgeParticipant {
   BridgeOptions options_;
   std::mutex mutex_;
   OdomFrame odom_;
-  std::deque<beaconloc::PoseEstimate> pending_transforms_;  // poses newer than the odometry received so far
+  PendingTransforms pending_transforms_;  // poses newer than the odometry received so far
   RejectionCounter counts_;
   std::uint64_t odometry_sequence_ = 0;
   // Topic names live here: the TopicSpecs point into them.

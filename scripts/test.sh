@@ -13,6 +13,9 @@
 # 2. build/release: every test (unit, multi-process integration on loopback, CLI) and the
 #    accuracy tests over many seeds, which stay Release-only (too slow under the sanitizers).
 # 3. build/fuzz: see below.
+# 4. the benchmark suite, briefly (scripts/bench.sh --quick): that every benchmark runs and
+#    writes its CSV. Its figures are not checked: speed and memory are read off BENCHMARKS.md's
+#    full runs, not asserted.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh Asan
@@ -29,3 +32,5 @@ ctest --test-dir build/release -j 2 --output-on-failure
 # 3. build/fuzz: the libFuzzer targets (clang), each run for 20 s from its seed corpus: a short,
 #    bounded smoke run in CI; docs/fuzzing.md has the long runs.
 bash scripts/fuzz.sh --seconds 20
+# 4. Every benchmark, briefly, into build/bench-quick (figures not checked).
+bash scripts/bench.sh --quick --out build/bench-quick

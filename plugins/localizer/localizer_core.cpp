@@ -65,37 +65,61 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
   }
   r->jump_candidate_ns.reset();
   counts_.accept();
-  auto estimate = r->fusion.estimator().estimate();
+  return output(robot_id, *r);
+}
+
+std::optional<LocalizerOutput> LocalizerCore::output(const std::string& robot_id, Robot& r) {
+  auto estimate = r.fusion.estimator().estimate();
   if (!estimate) return std::nullopt;
-  estimate->status = r->status();
-  LocalizerOutput out{robot_id, *estimate, {r->beacons_used.begin(), r->beacons_used.end()}};
-  r->beacons_used.clear();
+  estimate->status = r.status();
+  LocalizerOutput out{robot_id, *estimate, {r.beacons_used.begin(), r.beacons_used.end()}};
+  r.beacons_used.clear();
   return out;
 }
 
-void LocalizerCore::on_range(const std::string& robot_id, const RangeMeasurement& range) {
+namespace {
+bool same_estimate(const std::optional<PoseEstimate>& a, const std::optional<PoseEstimate>& b) {
+  if (a.has_value() != b.has_value()) return false;
+  return !a || (a->stamp_ns == b->stamp_ns && a->pose_map_base == b->pose_map_base &&
+                a->covariance == b->covariance);
+}
+}  // namespace
+
+std::optional<LocalizerOutput> LocalizerCore::correction_output(const std::string& robot_id, Robot& r,
+                                                                const std::optional<PoseEstimate>& before) {
+  if (same_estimate(before, r.fusion.estimator().estimate())) return std::nullopt;  // held, or gated
+  return output(robot_id, r);
+}
+
+std::optional<LocalizerOutput> LocalizerCore::on_range(const std::string& robot_id,
+                                                       const RangeMeasurement& range) {
   Robot* r = robot(robot_id, "range");
-  if (!r) return;
+  if (!r) return std::nullopt;
   r->ranges_silent = false;  // the bus delivers ranges again; whether they fit is the estimator's call
+  const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
   const InputResult result = r->fusion.update(range);
   if (!result.accepted) {
     counts_.reject("range." + result.rejection);
-    return;
+    return std::nullopt;
   }
   counts_.accept();
   r->beacons_used.insert(range.beacon_id);
+  return correction_output(robot_id, *r, before);
 }
 
-void LocalizerCore::on_laser(const std::string& robot_id, const LaserScanSample& scan) {
-  if (!uses_laser_) return;  // the participant does not subscribe to scans then; nothing to count
+std::optional<LocalizerOutput> LocalizerCore::on_laser(const std::string& robot_id,
+                                                       const LaserScanSample& scan) {
+  if (!uses_laser_) return std::nullopt;  // the participant does not subscribe to scans then
   Robot* r = robot(robot_id, "laser");
-  if (!r) return;
+  if (!r) return std::nullopt;
+  const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
   const InputResult result = r->fusion.update_laser(scan);
   if (!result.accepted) {
     counts_.reject("laser." + result.rejection);
-    return;
+    return std::nullopt;
   }
   counts_.accept();
+  return correction_output(robot_id, *r, before);
 }
 
 void LocalizerCore::on_initial_pose(const std::string& robot_id, StampNs stamp_ns, const Pose2& pose,

@@ -31,10 +31,15 @@ class LocalizerCore {
   bool has_beacon_map() const { return !map_.empty(); }
   // Predicts; returns the pose to publish once the robot's estimator has one.
   std::optional<LocalizerOutput> on_odometry(const std::string& robot_id, const OdometrySample& odometry);
-  void on_range(const std::string& robot_id, const RangeMeasurement& range);
+  // Corrects; returns the corrected pose when the measurement changed the estimate, so that it
+  // goes out at once rather than with the next odometry sample (up to 10 ms later). It carries
+  // the stamp of the pose already published for the newest odometry: a consumer keeps the
+  // newest pose per stamp. Nothing is returned when the estimator holds the measurement for a
+  // later odometry sample (ukf_lrf fuses at the measurement's own stamp) or gates it out.
+  std::optional<LocalizerOutput> on_range(const std::string& robot_id, const RangeMeasurement& range);
   // Laser scans reach estimators that use them (uses_laser()); others never see one.
   bool uses_laser() const { return uses_laser_; }
-  void on_laser(const std::string& robot_id, const LaserScanSample& scan);
+  std::optional<LocalizerOutput> on_laser(const std::string& robot_id, const LaserScanSample& scan);
   // Restarts the robot's estimator from a given pose (counted as initial_pose.<reason> if refused).
   void on_initial_pose(const std::string& robot_id, StampNs stamp_ns, const Pose2& pose_map_base,
                        const Cov3& covariance);
@@ -70,6 +75,10 @@ class LocalizerCore {
   static constexpr StampNs kClockJumpConfirmationNs = 200 * kNsPerMillisecond;
   bool clock_jumped_back(Robot& r, const OdometrySample& odometry);
   Robot* robot(const std::string& robot_id, const char* kind);
+  // The robot's pose to publish (none before its first fix), with the beacons fused since the last.
+  std::optional<LocalizerOutput> output(const std::string& robot_id, Robot& r);
+  std::optional<LocalizerOutput> correction_output(const std::string& robot_id, Robot& r,
+                                                   const std::optional<PoseEstimate>& before);
 
   std::string estimator_name_;
   EstimatorConfig config_;

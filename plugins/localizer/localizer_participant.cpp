@@ -2,6 +2,8 @@
 
 #include <beaconlocPubSubTypes.h>
 
+#include <algorithm>
+
 #include "beaconloc/dds/convert.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
 
@@ -26,8 +28,10 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       dds::kBeaconRangeTopic,
       [this](const msg::BeaconRange& m) {
         {
+          // Written under the lock, as every pose is, so that a robot's poses go out in stamp
+          // order: a correction at once, not with the next odometry sample.
           std::lock_guard<std::mutex> lock(mutex_);
-          core_.on_range(m.robot_id(), dds::from_msg(m));
+          if (auto corrected = core_.on_range(m.robot_id(), dds::from_msg(m))) publish(*corrected);
         }
         ++ranges_processed_;
       },
@@ -42,7 +46,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
   if (core_.uses_laser()) {
     participant_.subscribe<msg::LaserScanPubSubType>(dds::kLaserScanTopic, [this](const msg::LaserScan& m) {
       std::lock_guard<std::mutex> lock(mutex_);
-      core_.on_laser(m.robot_id(), dds::from_msg(m));
+      if (auto corrected = core_.on_laser(m.robot_id(), dds::from_msg(m))) publish(*corrected);
     });
   }
   participant_.subscribe<msg::InitialPosePubSubType>(
@@ -62,7 +66,6 @@ LocalizerParticipant::~LocalizerParticipant() {
 }
 
 void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
-  std::optional<LocalizerOutput> out;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     // Increments the bus dropped (a history too short for a stalled reader): counted, since an
@@ -77,13 +80,16 @@ void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
         last->second = seq;  // far back: a restarted gateway numbering from 0 again
       }
     }
-    out = core_.on_odometry(m.robot_id(), dds::from_msg(m));
-  }
-  if (out) {
-    auto p = dds::to_msg(out->robot_id, out->estimate, core_.estimator_name(), out->beacons_used);
-    pose_writer_->write(&p);
+    if (auto out = core_.on_odometry(m.robot_id(), dds::from_msg(m))) publish(*out);
+    newest_odometry_stamp_ns_ = std::max(newest_odometry_stamp_ns_.load(), m.stamp_ns());
   }
   ++odometry_processed_;
+}
+
+void LocalizerParticipant::publish(const LocalizerOutput& out) {
+  auto p = dds::to_msg(out.robot_id, out.estimate, core_.estimator_name(), out.beacons_used);
+  pose_writer_->write(&p);
+  ++poses_written_;
 }
 
 msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {

@@ -23,10 +23,19 @@ class LocalizerParticipant {
   // Samples taken from the bus, for a throttle in the same process.
   std::uint64_t odometry_processed() const { return odometry_processed_.load(); }
   std::uint64_t ranges_processed() const { return ranges_processed_.load(); }
+  // Poses written (one per odometry sample once localized, plus corrections), and the stamp of
+  // the newest odometry sample taken: for benchmarks in the same process.
+  std::uint64_t poses_written() const { return poses_written_.load(); }
+  StampNs newest_odometry_stamp_ns() const { return newest_odometry_stamp_ns_.load(); }
+  std::uint64_t lost_increments() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return lost_increments_;
+  }
 
  private:
   msg::Diagnostics diagnostics_snapshot();
   void on_odometry(const msg::Odometry& odometry);
+  void publish(const LocalizerOutput& out);  // under mutex_
 
   std::mutex mutex_;
   LocalizerCore core_;
@@ -38,6 +47,8 @@ class LocalizerParticipant {
   std::atomic<bool> odometry_writer_lost_{false};           // lost, none alive since
   std::atomic<std::uint64_t> odometry_processed_{0};
   std::atomic<std::uint64_t> ranges_processed_{0};
+  std::atomic<std::uint64_t> poses_written_{0};
+  std::atomic<StampNs> newest_odometry_stamp_ns_{0};
   dds::Participant participant_;
   eprosima::fastdds::dds::DataWriter* pose_writer_;
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;

@@ -11,6 +11,12 @@ PoseRecorder::PoseRecorder(const dds::DdsOptions& dds) : participant_(dds, "beac
       dds::kPoseEstimateTopic, [this](const msg::PoseEstimate& m) {
         RecordedPose p{{m.robot_id(), dds::from_msg(m), m.estimator()}, std::chrono::steady_clock::now()};
         std::lock_guard<std::mutex> lock(mutex_);
+        auto [newest, first] = newest_of_robot_.try_emplace(p.row.robot_id, poses_.size());
+        if (!first && poses_[newest->second].row.estimate.stamp_ns == p.row.estimate.stamp_ns) {
+          poses_[newest->second] = std::move(p);  // a correction of the same pose
+          return;
+        }
+        newest->second = poses_.size();
         poses_.push_back(std::move(p));
       });
 }

@@ -1,7 +1,10 @@
 #pragma once
 // Records the PoseEstimate topic with the wall time each pose arrived: the demo, `run`,
 // `monitor` and the tests measure accuracy against ground truth and the pose rate with it.
+// A pose at the stamp of a robot's previous one is that pose corrected by a range (the localizer
+// publishes a correction at once): it replaces the previous one, so each stamp is scored once.
 #include <chrono>
+#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -27,6 +30,7 @@ class PoseRecorder {
  private:
   mutable std::mutex mutex_;
   std::vector<RecordedPose> poses_;
+  std::map<std::string, std::size_t> newest_of_robot_;  // index into poses_
   dds::Participant participant_;
 };
 

@@ -30,6 +30,14 @@ TEST(LocalizerCore, KeepsRobotsApartOnSharedTopics) {
   double worst = 0.0;
   std::set<std::uint32_t> used;
   auto feed = [&](const std::string& robot, const SourceEvent& e) {
+    if (e.kind == SourceEvent::Kind::kTof) {  // corrections carry the beacons they fused
+      if (const auto d = stack.decoder.decode(robot, e.tof); d.range) {
+        if (auto corrected = stack.localizer.on_range(robot, d.range->range)) {
+          used.insert(corrected->beacons_used.begin(), corrected->beacons_used.end());
+        }
+      }
+      return;
+    }
     if (auto pose = stack.feed(robot, e)) {
       if (e.stamp_ns > s_to_ns(robot == "a" ? 3.0 : 10.0)) {
         worst = std::max(worst, (pose->estimate.pose_map_base.head<2>() - e.truth_map_base.head<2>()).norm());
@@ -89,6 +97,42 @@ struct LocalizedRobot {
     }
   }
 };
+
+// A range that changes the estimate gives the corrected pose at once, at the stamp of the pose
+// already given for the newest odometry, naming the beacon; a range gated out gives nothing.
+TEST(LocalizerCore, ACorrectionIsPublishedAtOnceAndAGatedRangeIsNot) {
+  LocalizedRobot robot;
+  robot.feed(0.0, 5.0);
+  ASSERT_TRUE(robot.last);
+  std::size_t corrections = 0;
+  for (auto e : robot.events) {
+    if (e.stamp_ns < s_to_ns(5.0) || e.stamp_ns >= s_to_ns(8.0)) continue;
+    if (e.kind == SourceEvent::Kind::kOdometry) {
+      if (auto out = robot.core.on_odometry("r", e.odometry)) robot.last = out;
+      continue;
+    }
+    if (e.kind != SourceEvent::Kind::kTof) continue;
+    const auto d = robot.decoder.decode("r", e.tof);
+    if (!d.range) continue;
+    const PoseEstimate before = robot.last->estimate;
+    const auto corrected = robot.core.on_range("r", d.range->range);
+    if (!corrected) continue;
+    ++corrections;
+    EXPECT_EQ(corrected->estimate.stamp_ns, before.stamp_ns);
+    EXPECT_LT(corrected->estimate.covariance.trace(), before.covariance.trace());
+    EXPECT_EQ(corrected->beacons_used, std::vector<std::uint32_t>{d.range->range.beacon_id});
+    robot.last = corrected;
+  }
+  EXPECT_GE(corrections, 30u);  // 3 s of beacon slots at 5 Hz, several receivers each
+
+  RangeMeasurement far = {};
+  far.stamp_ns = robot.last->estimate.stamp_ns;
+  far.beacon_id = robot.scenario.beacons.front().id;
+  far.receiver_id = 0;
+  far.range_m = 100.0;  // nowhere near: gated out
+  far.variance_m2 = 1e-4;
+  EXPECT_FALSE(robot.core.on_range("r", far));
+}
 
 // Silent ranges (the participant's beacon_range deadline) make the poses degraded at once; the
 // next range clears it.

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "odom_frame.hpp"
+#include "pending_transforms.hpp"
 #include "ros2_convert.hpp"
 
 namespace beaconloc::bridge {
@@ -152,6 +153,36 @@ TEST(Ros2Bridge, BeaconMarkersAndRanges) {
   EXPECT_EQ(range.radiation_type(), kRangeUltrasound);
   EXPECT_EQ(range.range(), 2.25f);
   EXPECT_EQ(range.header().frame_id(), "receiver_0");
+}
+
+// A correction (a pose at the previous pose's stamp) replaces the pose still waiting for its
+// odometry; once that stamp's transform is out, a correction is dropped (tf2 would warn of a
+// repeat); poses wait until the odometry reaches their stamp; a full queue gives the oldest up.
+TEST(Ros2Bridge, PendingTransformsTakeCorrectionsOnceAndWaitForOdometry) {
+  auto pose = [](StampNs stamp_ns, double x_m) {
+    PoseEstimate e;
+    e.stamp_ns = stamp_ns;
+    e.pose_map_base = Pose2(x_m, 0.0, 0.0);
+    return e;
+  };
+  PendingTransforms pending(3);
+  using Added = PendingTransforms::Added;
+  EXPECT_EQ(pending.add(pose(10, 1.0)), Added::kQueued);
+  EXPECT_EQ(pending.add(pose(10, 1.5)), Added::kReplacedWaiting);
+  EXPECT_EQ(pending.add(pose(20, 2.0)), Added::kQueued);
+  EXPECT_TRUE(pending.take_reached(9).empty());
+  const auto reached = pending.take_reached(15);
+  ASSERT_EQ(reached.size(), 1u);
+  EXPECT_EQ(reached[0].pose_map_base.x(), 1.5);
+  pending.published(10);
+  EXPECT_EQ(pending.add(pose(10, 1.6)), Added::kAlreadyPublished);
+  EXPECT_EQ(pending.size(), 1u);
+  EXPECT_EQ(pending.add(pose(30, 3.0)), Added::kQueued);
+  EXPECT_EQ(pending.add(pose(40, 4.0)), Added::kQueued);
+  EXPECT_EQ(pending.add(pose(50, 5.0)), Added::kQueuedDroppedOldest);
+  const auto rest = pending.take_reached(100);
+  ASSERT_EQ(rest.size(), 3u);
+  EXPECT_EQ(rest.front().stamp_ns, 30);
 }
 
 }  // namespace

@@ -52,6 +52,8 @@ std::optional<LocalizerOutput> OfflineStack::feed(const std::string& robot_id, c
   if (e.kind == SourceEvent::Kind::kTof) {
     if (const auto out = decoder.decode(robot_id, e.tof); out.range) {
       if (e.true_beacon_id != kBeaconUnidentified) range_truth_[out.range->range.stamp_ns] = e.true_beacon_id;
+      // The corrected pose a live localizer publishes at once is not a row here: offline, each
+      // odometry sample's pose is scored, and a correction shows in the next one.
       localizer.on_range(robot_id, out.range->range);
     }
     return std::nullopt;

@@ -1,5 +1,6 @@
 #include "distance_prediction.hpp"
 
+#include <array>
 #include <cmath>
 
 #include "beaconloc/core/models/range_model.hpp"
@@ -7,8 +8,17 @@
 namespace beaconloc::duhl {
 
 Eigen::Vector2d ReceiverRing::receiver(int l) const {
-  const double g = 2.0 * M_PI * l / 3.0;  // eq. 1
-  return {radius_m * std::cos(g), radius_m * std::sin(g)};
+  // Eq. 1, g_l = 2 pi (l-1) / 3: the cosines and sines computed once (every prediction of every
+  // Tx's distances asks for the three receivers).
+  static const std::array<Eigen::Vector2d, 3> unit = [] {
+    std::array<Eigen::Vector2d, 3> u;
+    for (int k = 0; k < 3; ++k) {
+      const double g = 2.0 * M_PI * k / 3.0;
+      u[k] = {std::cos(g), std::sin(g)};
+    }
+    return u;
+  }();
+  return {radius_m * unit[l].x(), radius_m * unit[l].y()};
 }
 
 namespace {
@@ -28,21 +38,25 @@ BearingTerms bearing_terms(const Distances& q, double r_r) {
   return t;
 }
 
+// sqrt((rho^i)^2 - z_T^2), rho^i from eq. 11.
+double planar_range(const Distances& q, double z, const ReceiverRing& ring) {
+  const double rho_sq = q.squaredNorm() / 3.0 - ring.radius_m * ring.radius_m;  // eq. 11
+  return std::sqrt(std::max(0.0, rho_sq - z * z));
+}
+
 }  // namespace
 
 TxGeometry tx_geometry(const Distances& q, double z, const ReceiverRing& ring) {
-  const double rho_sq = q.squaredNorm() / 3.0 - ring.radius_m * ring.radius_m;  // eq. 11
   const BearingTerms b = bearing_terms(q, ring.radius_m);
-  return {std::sqrt(std::max(0.0, rho_sq - z * z)), std::atan2(b.s, b.c)};
+  return {planar_range(q, z, ring), std::atan2(b.s, b.c)};
 }
 
 DistancePrediction predict_distances(const Distances& q, double z, double v_r, double v_l,
                                      double wheel_base_m, double dt_s, const ReceiverRing& ring) {
   const double delta_d = dt_s * (v_r + v_l) / 2.0;  // eq. 14
   const double delta_phi = dt_s * (v_r - v_l) / wheel_base_m;
-  const TxGeometry geo = tx_geometry(q, z, ring);
-  const double r = geo.planar_range_m, theta = geo.bearing_rad;
   const BearingTerms b = bearing_terms(q, ring.radius_m);
+  const double r = planar_range(q, z, ring);
   // d r / d q_m = q_m / (3 r); d theta / d q = (C dS - S dC) / (C^2 + S^2).
   const Eigen::RowVector3d dr =
       r > 1e-9 ? Eigen::RowVector3d(q.transpose() / (3.0 * r)) : Eigen::RowVector3d::Zero();
@@ -52,28 +66,38 @@ DistancePrediction predict_distances(const Distances& q, double z, double v_r, d
 
   DistancePrediction out;
   Eigen::Matrix<double, 3, 2> d_g_d_increment;  // d g / d [Delta D, Delta phi]
+  // The angles are the same for the three receivers: their sines and cosines, once. The bearing
+  // theta = atan2(S, C) (tx_geometry) enters only through them: cos(theta) = C / sqrt(C^2 + S^2),
+  // sin(theta) = S / sqrt(C^2 + S^2) (theta = 0 where C = S = 0, as atan2(0, 0) gives), and
+  // theta - Delta phi / 2 by the angle-difference identities.
+  const double half = delta_phi / 2.0;
+  const double cos_half = std::cos(half), sin_half = std::sin(half);
+  const double cs_norm = std::sqrt(cs_sq);
+  const double cos_theta = cs_norm > 0.0 ? b.c / cs_norm : 1.0,
+               sin_theta = cs_norm > 0.0 ? b.s / cs_norm : 0.0;
+  const double cos_theta_half = cos_theta * cos_half + sin_theta * sin_half;
+  const double sin_theta_half = sin_theta * cos_half - cos_theta * sin_half;
   for (int l = 0; l < 3; ++l) {
     const Eigen::Vector2d rx = ring.receiver(l);
-    const double half = delta_phi / 2.0;
-    const double alpha = delta_d * (rx.x() * std::cos(half) + rx.y() * std::sin(half));
-    const double lever = rx.x() * std::sin(theta) - rx.y() * std::cos(theta);
-    const double bracket = delta_d * std::cos(theta - half) + delta_phi * lever;
+    const double alpha = delta_d * (rx.x() * cos_half + rx.y() * sin_half);
+    const double lever = rx.x() * sin_theta - rx.y() * cos_theta;
+    const double bracket = delta_d * cos_theta_half + delta_phi * lever;
     const double beta = r * bracket;
     out.q(l) = q(l) + (alpha - beta) / q(l);
 
     // J_g,q (eq. 24): d g_l / d q_m = delta_lm (1 - (alpha - beta) / q_l^2) - (1 / q_l) d beta_l / d q_m.
     const double dbeta_dr = bracket;
-    const double dbeta_dtheta = r * (-delta_d * std::sin(theta - half) +
-                                     delta_phi * (rx.x() * std::cos(theta) + rx.y() * std::sin(theta)));
+    const double dbeta_dtheta =
+        r * (-delta_d * sin_theta_half + delta_phi * (rx.x() * cos_theta + rx.y() * sin_theta));
     const Eigen::RowVector3d dbeta_dq = dbeta_dr * dr + dbeta_dtheta * dtheta;
     out.jacobian_q.row(l) = -dbeta_dq / q(l);
     out.jacobian_q(l, l) += 1.0 - (alpha - beta) / (q(l) * q(l));
 
     // J_g,u through the increments.
-    const double dalpha_dd = rx.x() * std::cos(half) + rx.y() * std::sin(half);
-    const double dalpha_dphi = delta_d * (-rx.x() * std::sin(half) + rx.y() * std::cos(half)) / 2.0;
-    const double dbeta_dd = r * std::cos(theta - half);
-    const double dbeta_dphi = r * (delta_d * std::sin(theta - half) / 2.0 + lever);
+    const double dalpha_dd = rx.x() * cos_half + rx.y() * sin_half;
+    const double dalpha_dphi = delta_d * (-rx.x() * sin_half + rx.y() * cos_half) / 2.0;
+    const double dbeta_dd = r * cos_theta_half;
+    const double dbeta_dphi = r * (delta_d * sin_theta_half / 2.0 + lever);
     d_g_d_increment(l, 0) = (dalpha_dd - dbeta_dd) / q(l);
     d_g_d_increment(l, 1) = (dalpha_dphi - dbeta_dphi) / q(l);
   }

@@ -172,6 +172,7 @@ Duhl::TxEstimate Duhl::new_tx_estimate(const RangeMeasurement& r) const {
 // information once (covariance intersection's equal split).
 Cov3 Duhl::observation_covariance(const std::vector<TxDistances>& txs, const UhlSolution& z) const {
   std::vector<DistanceCov> covariances;
+  covariances.reserve(available_.size());
   const double reuse = static_cast<double>(available_.size());
   for (const auto& [id, e] : available_) {
     covariances.push_back(params_.observation_covariance_as_printed ? e.covariance
@@ -184,6 +185,7 @@ void Duhl::observe() {
   pending_observation_ = false;
   if (available_.size() < 2) return;
   std::vector<TxDistances> txs;
+  txs.reserve(available_.size());
   for (const auto& [id, e] : available_) txs.push_back({map_.find(id)->position_map_m, e.q});
   const UhlSolution z = solve_uhl(txs, params_.uhl);
   if (!z.ok) return;

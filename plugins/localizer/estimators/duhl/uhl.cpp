@@ -2,15 +2,24 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
+#include <array>
 #include <cmath>
 
 namespace beaconloc::duhl {
 namespace {
 
-// The receivers' positions in the robot frame (eq. 1): r_R [cos g_l, sin g_l], g_l = 2 pi (l-1) / 3.
+// The receivers' positions in the robot frame (eq. 1): r_R [cos g_l, sin g_l], g_l = 2 pi (l-1) / 3
+// (the cosines and sines computed once: they sat in the UHL's hot loops).
 Eigen::Vector2d receiver_base(int l, double r_r) {
-  const double g = 2.0 * M_PI * l / 3.0;
-  return {r_r * std::cos(g), r_r * std::sin(g)};
+  static const std::array<Eigen::Vector2d, 3> unit = [] {
+    std::array<Eigen::Vector2d, 3> u;
+    for (int k = 0; k < 3; ++k) {
+      const double g = 2.0 * M_PI * k / 3.0;
+      u[k] = {std::cos(g), std::sin(g)};
+    }
+    return u;
+  }();
+  return {r_r * unit[l].x(), r_r * unit[l].y()};
 }
 
 // The line l_T through the Txs (principal axis of their planar positions): centroid, unit
@@ -57,13 +66,20 @@ struct EqFourRows {
 
 double eq_four_k(double r_r) { return 1.0 / (2.0 * std::sqrt(3.0) * r_r); }
 
+// A^{i,j} of eq. 4 from the Tx offset [dx, dy] = p_j - p_i (linear in it).
+Eigen::Matrix2d eq_four_rows_of(const Eigen::Vector2d& offset) {
+  Eigen::Matrix2d a;
+  a << std::sqrt(3.0) * offset.x(), std::sqrt(3.0) * offset.y(), -offset.y(), offset.x();
+  return a;
+}
+
 EqFourRows eq_four_rows(const TxDistances& ti, const TxDistances& tj, double r_r) {
   const Eigen::Vector3d& di = ti.distances_m;
   const Eigen::Vector3d& dj = tj.distances_m;
   const double k = eq_four_k(r_r);
   const double dx = tj.tx_map_m.x() - ti.tx_map_m.x(), dy = tj.tx_map_m.y() - ti.tx_map_m.y();
   EqFourRows rows;
-  rows.a << std::sqrt(3.0) * dx, std::sqrt(3.0) * dy, -dy, dx;
+  rows.a = eq_four_rows_of({dx, dy});
   rows.b << k * (2 * di(0) * di(0) - di(1) * di(1) - di(2) * di(2) - 2 * dj(0) * dj(0) + dj(1) * dj(1) +
                  dj(2) * dj(2)),
       k * (-di(1) * di(1) + di(2) * di(2) + dj(1) * dj(1) - dj(2) * dj(2));
@@ -78,11 +94,31 @@ Eigen::Matrix<double, 2, 3> eq_four_gradient(const Eigen::Vector3d& d, double r_
   return g;
 }
 
+// Eq. 4 for every pair of Txs, accumulated straight into the normal equations A^T A Phi = A^T b.
+struct EqFourNormal {
+  Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d atb = Eigen::Vector2d::Zero();
+};
+
+EqFourNormal eq_four_normal(const std::vector<TxDistances>& txs, double r_r) {
+  EqFourNormal out;
+  const std::size_t n = txs.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const EqFourRows rows = eq_four_rows(txs[i], txs[j], r_r);
+      out.ata += rows.a.transpose() * rows.a;
+      out.atb += rows.a.transpose() * rows.b;
+    }
+  }
+  return out;
+}
+
 // Eq. 7 as a function of phi, and its derivative.
 struct Eq7 {
   double a1, a2, a3, b1, b2;
-  double value(double phi) const {
-    const double c = std::cos(phi), s = std::sin(phi);
+  double value(double phi) const { return value(std::cos(phi), std::sin(phi)); }
+  // The same at [cos phi, sin phi] = [c, s].
+  double value(double c, double s) const {
     return a3 * (c * c - s * s) + (a2 - a1) * c * s + b2 * c - b1 * s;
   }
   double derivative(double phi) const {
@@ -114,21 +150,10 @@ std::vector<double> real_quartic_roots(double k4, double k3, double k2, double k
   return roots;
 }
 
-}  // namespace
-
-std::optional<double> uhl_orientation(const std::vector<TxDistances>& txs, const UhlOptions& o) {
-  // Eq. 4: two rows per pair of Txs, accumulated straight into A^T A and A^T b.
-  const int n = static_cast<int>(txs.size());
-  if (n < 2) return std::nullopt;
-  Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d atb = Eigen::Vector2d::Zero();
-  for (int i = 0; i < n; ++i) {
-    for (int j = i + 1; j < n; ++j) {
-      const EqFourRows rows = eq_four_rows(txs[i], txs[j], o.receiver_radius_m);
-      ata += rows.a.transpose() * rows.a;
-      atb += rows.a.transpose() * rows.b;
-    }
-  }
+// Eq. 5-9 on eq. 4's normal equations.
+std::optional<double> orientation_from(const EqFourNormal& normal) {
+  const Eigen::Matrix2d& ata = normal.ata;
+  const Eigen::Vector2d& atb = normal.atb;
   if (!well_conditioned(ata)) return std::nullopt;
   const Eigen::Vector2d phi_pinv = ata.ldlt().solve(atb);  // the pseudoinverse solution of eq. 4
 
@@ -147,13 +172,13 @@ std::optional<double> uhl_orientation(const std::vector<TxDistances>& txs, const
       s = std::clamp(s, -1.0, 1.0);
       for (double sign : {1.0, -1.0}) {  // eq. 9: cos = +-sqrt(1 - sin^2), up to eight candidates
         const double c = sign * std::sqrt(1.0 - s * s);
-        const double phi = std::atan2(s, c);
-        // Squaring to reach the quartic adds roots: keep those that satisfy eq. 7 (ERRATA).
-        if (std::abs(eq7.value(phi)) > 1e-6 * eq7.scale()) continue;
+        // Squaring to reach the quartic adds roots: keep those that satisfy eq. 7 (ERRATA),
+        // evaluated at [c, s] itself (the angle is needed only for the one kept).
+        if (std::abs(eq7.value(c, s)) > 1e-6 * eq7.scale()) continue;
         const double distance = (Eigen::Vector2d(c, s) - phi_pinv).norm();
         if (distance < best_distance) {
           best_distance = distance;
-          best_phi = phi;
+          best_phi = std::atan2(s, c);
         }
       }
     }
@@ -167,6 +192,14 @@ std::optional<double> uhl_orientation(const std::vector<TxDistances>& txs, const
   return wrap_angle_rad(best_phi);
 }
 
+}  // namespace
+
+std::optional<double> uhl_orientation(const std::vector<TxDistances>& txs, const UhlOptions& o) {
+  // Eq. 4: two rows per pair of Txs.
+  if (txs.size() < 2) return std::nullopt;
+  return orientation_from(eq_four_normal(txs, o.receiver_radius_m));
+}
+
 std::optional<Eigen::Vector2d> uhl_direct_position(const std::vector<TxDistances>& txs, double yaw,
                                                    const UhlOptions& o) {
   // Eq. 10: G_DM [x, y, x^2 + y^2]^T = h_DM, three rows per Tx (ERRATA: every row of h_DM is
@@ -176,12 +209,17 @@ std::optional<Eigen::Vector2d> uhl_direct_position(const std::vector<TxDistances
   Eigen::Matrix3d gtg = Eigen::Matrix3d::Zero();
   Eigen::Vector3d gth = Eigen::Vector3d::Zero();
   const double c = std::cos(yaw), s = std::sin(yaw);
+  // g_l: the receivers rotated by the heading, the same for every Tx.
+  std::array<Eigen::Vector2d, 3> g;
+  for (int l = 0; l < 3; ++l) {
+    const Eigen::Vector2d r = receiver_base(l, o.receiver_radius_m);
+    g[l] = {r.x() * c - r.y() * s, r.x() * s + r.y() * c};
+  }
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d& t = txs[i].tx_map_m;
     const double z = t.z() - o.receiver_height_m;
     for (int l = 0; l < 3; ++l) {
-      const Eigen::Vector2d r = receiver_base(l, o.receiver_radius_m);
-      const double gx = r.x() * c - r.y() * s, gy = r.x() * s + r.y() * c;
+      const double gx = g[l].x(), gy = g[l].y();
       const double d = txs[i].distances_m(l);
       const Eigen::Vector3d row(t.x() - gx, t.y() - gy, -0.5);
       gtg += row * row.transpose();
@@ -273,7 +311,10 @@ UhlSolution solve_uhl(const std::vector<TxDistances>& txs, const UhlOptions& o) 
       return out;
     }
   }
-  const auto yaw = uhl_orientation(txs, o);  // Table I, line 1
+  const EqFourNormal normal = eq_four_normal(txs, o.receiver_radius_m);
+  out.eq4_ata = normal.ata;
+  out.eq4_atb = normal.atb;
+  const auto yaw = orientation_from(normal);  // Table I, line 1
   if (!yaw) {
     out.failure = "orientation_unobservable";
     return out;
@@ -310,43 +351,44 @@ std::optional<UhlJacobian> uhl_jacobian(const std::vector<TxDistances>& txs, con
   // Heading: the DM's phi solves eq. 7, E(phi, A^T b) = 0 (A does not depend on the distances),
   // so d phi / d q = -(dE / d(A^T b)) (d(A^T b) / d q) / (dE / d phi), with dE / d(A^T b) =
   // [sin phi, -cos phi] from A^T b = -[b1, b2].
-  // d(A^T b) / d d^a = S_a db/dd(d^a), S_a = sum over the pairs (a, b > a) of A^{a,b}^T minus
-  // that over the pairs (b < a, a) (eq_four_gradient).
-  Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d atb = Eigen::Vector2d::Zero();
-  std::vector<Eigen::Matrix2d> s_of(n, Eigen::Matrix2d::Zero());
-  for (int a = 0; a < n; ++a) {
-    for (int b = a + 1; b < n; ++b) {
-      const EqFourRows rows = eq_four_rows(txs[a], txs[b], o.receiver_radius_m);
-      ata += rows.a.transpose() * rows.a;
-      atb += rows.a.transpose() * rows.b;
-      s_of[a] += rows.a.transpose();
-      s_of[b] -= rows.a.transpose();
-    }
-  }
+  // d(A^T b) / d d^a = S_a db/dd(d^a) (eq_four_gradient), S_a the sum over the pairs (a, b > a)
+  // of A^{a,b}^T minus that over the pairs (b < a, a). A^{a,b} is linear in the Tx offset
+  // p_b - p_a (eq_four_rows), so S_a = sum over b != a of A(p_b - p_a)^T = A(P - n p_a)^T, P the
+  // sum of the Tx positions: one term per Tx instead of one per pair.
+  // A^T A and A^T b are the solution's own (solve_uhl keeps them).
+  Eigen::Vector2d p_sum = Eigen::Vector2d::Zero();
+  for (const auto& t : txs) p_sum += t.tx_map_m.head<2>();
   const double phi = solution.pose.z();
-  const Eq7 eq7 = eq7_of(ata, atb);
+  const Eq7 eq7 = eq7_of(solution.eq4_ata, solution.eq4_atb);
   const double slope = eq7.derivative(phi);
   if (!(std::abs(slope) > 1e-12 * eq7.scale())) return std::nullopt;
   const Eigen::RowVector2d de_datb(std::sin(phi), -std::cos(phi));
   for (int a = 0; a < n; ++a) {
+    const Eigen::Vector2d offset = p_sum - n * txs[a].tx_map_m.head<2>();
+    const Eigen::Matrix2d s_a = eq_four_rows_of(offset).transpose();
     j.block<1, 3>(2, 3 * a) =
-        -(de_datb * s_of[a] * eq_four_gradient(txs[a].distances_m, o.receiver_radius_m)) / slope;
+        -(de_datb * s_a * eq_four_gradient(txs[a].distances_m, o.receiver_radius_m)) / slope;
   }
 
   // Position: the IMR multilateration p = (M^T M)^-1 M^T v, M fixed by the Tx positions and
-  // v_i = r_0^2 - r_i^2 + const with r_i^2 = |d^i|^2 / 3 - r_R^2 - z_i^2 (eq. 11).
+  // v_i = r_0^2 - r_i^2 + const with r_i^2 = |d^i|^2 / 3 - r_R^2 - z_i^2 (eq. 11). With m_i the
+  // row of M for Tx i and w_i = (M^T M)^-1 m_i: d p / d d^i = -(2/3) w_i d^i^T (i >= 1) and
+  // d p / d d^0 = (2/3) (sum_i w_i) d^0^T.
   Eigen::Matrix2d mtm = Eigen::Matrix2d::Zero();
-  Eigen::Matrix<double, 2, Eigen::Dynamic> dmtv_dq = Eigen::Matrix<double, 2, Eigen::Dynamic>::Zero(2, 3 * n);
   const Eigen::Vector2d p0 = txs[0].tx_map_m.head<2>();
   for (int i = 1; i < n; ++i) {
     const Eigen::Vector2d row = 2.0 * (txs[i].tx_map_m.head<2>() - p0);
     mtm += row * row.transpose();
-    dmtv_dq.middleCols<3>(0) += row * (2.0 / 3.0) * txs[0].distances_m.transpose();
-    dmtv_dq.middleCols<3>(3 * i) -= row * (2.0 / 3.0) * txs[i].distances_m.transpose();
   }
   if (!well_conditioned(mtm)) return std::nullopt;
-  j.topRows<2>() = mtm.ldlt().solve(dmtv_dq);
+  const Eigen::LDLT<Eigen::Matrix2d> ldlt(mtm);
+  Eigen::Vector2d w_sum = Eigen::Vector2d::Zero();
+  for (int i = 1; i < n; ++i) {
+    const Eigen::Vector2d w = ldlt.solve(Eigen::Vector2d(2.0 * (txs[i].tx_map_m.head<2>() - p0)));
+    w_sum += w;
+    j.block<2, 3>(0, 3 * i) = -(2.0 / 3.0) * w * txs[i].distances_m.transpose();
+  }
+  j.block<2, 3>(0, 0) = (2.0 / 3.0) * w_sum * txs[0].distances_m.transpose();
   return j;
 }
 

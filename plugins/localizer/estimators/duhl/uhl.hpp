@@ -44,6 +44,9 @@ struct UhlSolution {
   Eigen::Vector2d direct_position_m = Eigen::Vector2d::Zero();  // p_DM, always computed
   bool collinear = false;
   std::string failure;  // why ok is false
+  // Eq. 4's normal equations A^T A Phi = A^T b at these distances, for the Jacobian (uhl_jacobian).
+  Eigen::Matrix2d eq4_ata = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d eq4_atb = Eigen::Vector2d::Zero();
 };
 
 // Eq. 4-9: the robot's heading; nullopt when A is rank-deficient (fewer than two distinct Txs).
@@ -59,8 +62,8 @@ std::optional<Eigen::Vector2d> uhl_indirect_position(const std::vector<TxDistanc
 // Table I.
 UhlSolution solve_uhl(const std::vector<TxDistances>& txs, const UhlOptions& options = {});
 
-// d pose / d [d^1; d^2; ...] (3 x 3N) of a solution, analytic, where the pose is the DM heading
-// (eq. 4-9) and the IMR multilateration (eq. 11) on non-collinear Txs; nullopt on the other
+// d pose / d [d^1; d^2; ...] (3 x 3N) of a solution of solve_uhl on these txs, analytic, where the pose is
+// the DM heading (eq. 4-9) and the IMR multilateration (eq. 11) on non-collinear Txs; nullopt on the other
 // branches of Table I (collinear Txs), whose Jacobian is left to numeric differentiation.
 using UhlJacobian = Eigen::Matrix<double, 3, Eigen::Dynamic>;
 std::optional<UhlJacobian> uhl_jacobian(const std::vector<TxDistances>& txs, const UhlSolution& solution,

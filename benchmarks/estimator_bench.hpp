@@ -1,0 +1,181 @@
+#pragma once
+// What the estimator benchmarks share: the inputs an estimator sees in a simulated scenario (the
+// simulator's odometry and laser scans, its TOFs through the decoder), a snapshot of an estimator
+// at a chosen moment of that run with the inputs of the step that follows, and a loop that times
+// that one step again and again, each time on a fresh copy of the snapshot (so the filter never
+// drifts away from the realistic state it was taken in).
+#include <benchmark/benchmark.h>
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/estimator_registry.hpp"
+#include "sim/scenario.hpp"
+#include "sim/scenario_yaml.hpp"
+#include "sim/sim_source.hpp"
+#include "tof_decoder.hpp"
+
+namespace beaconloc::bench {
+
+// One input as the localizer pushes it to its estimator.
+struct Input {
+  enum class Kind { kOdometry, kRange, kScan };
+  Kind kind = Kind::kOdometry;
+  StampNs stamp_ns = 0;
+  OdometrySample odometry;
+  RangeMeasurement range;
+  LaserScanSample scan;
+  Pose2 truth = Pose2::Zero();  // the simulator's truth, on odometry inputs
+};
+
+inline sim::Scenario scenario_file(const std::string& name) {
+  return sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/" + name);
+}
+
+inline EstimatorConfig config_for(const sim::Scenario& s) {
+  EstimatorConfig c;
+  c.receivers = s.receivers;
+  if (s.map) c.occupancy_grid = std::make_shared<const OccupancyGrid>(*s.map);
+  c.initial_pose = s.trajectory.pose_at(0.0);  // placed by hand, as in seed 001
+  return c;
+}
+
+// The simulated run (seed `seed`, duration_s) as the estimator's inputs, in arrival order.
+inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t seed, double duration_s) {
+  sim::SimSource source(s, seed);
+  std::vector<SourceEvent> events;
+  source.advance(s_to_ns(duration_s), events);
+  TofDecoderConfig dc;
+  dc.min_range_m = s.min_range_m;
+  dc.max_range_m = s.max_range_m;
+  dc.range_sigma_m = s.range_sigma_m;
+  TofDecoder decoder(dc);
+  decoder.set_beacon_map(BeaconMap(s.beacons));
+  std::vector<Input> out;
+  for (const SourceEvent& e : events) {
+    Input in;
+    in.stamp_ns = e.stamp_ns;
+    switch (e.kind) {
+      case SourceEvent::Kind::kOdometry:
+        in.kind = Input::Kind::kOdometry;
+        in.odometry = e.odometry;
+        in.truth = e.truth_map_base;
+        break;
+      case SourceEvent::Kind::kTof: {
+        const DecodeOutcome d = decoder.decode("robot1", e.tof);
+        if (!d.range) continue;
+        in.kind = Input::Kind::kRange;
+        in.range = d.range->range;
+        break;
+      }
+      case SourceEvent::Kind::kLaserScan:
+        in.kind = Input::Kind::kScan;
+        in.scan = e.scan;
+        break;
+      case SourceEvent::Kind::kTruth:
+        continue;
+    }
+    out.push_back(std::move(in));
+  }
+  return out;
+}
+
+inline InputResult push(Estimator& e, const Input& in) {
+  switch (in.kind) {
+    case Input::Kind::kOdometry:
+      return e.predict(in.odometry);
+    case Input::Kind::kRange:
+      return e.update(in.range);
+    case Input::Kind::kScan:
+      return e.update_laser(in.scan);
+  }
+  return InputResult::rejected("unknown_input");
+}
+
+// An estimator as it was at a moment of the run, and the inputs of the step timed from there.
+struct Snapshot {
+  std::unique_ptr<Estimator> estimator;
+  std::vector<Input> step;
+  Pose2 truth = Pose2::Zero();  // at the newest odometry stamp the estimator has seen
+};
+
+// The inputs after inputs[k], up to and including the next odometry sample (empty when the run
+// ends first).
+inline std::vector<Input> next_step(const std::vector<Input>& inputs, std::size_t k) {
+  std::vector<Input> step;
+  for (std::size_t j = k + 1; j < inputs.size(); ++j) {
+    step.push_back(inputs[j]);
+    if (inputs[j].kind == Input::Kind::kOdometry) return step;
+  }
+  return {};
+}
+
+// Runs `name` on the inputs and stops after the first input k (past warmup_s) for which
+// step_at(estimator, inputs, k) gives the step to time. Throws when there is none.
+using StepAt = std::function<std::optional<std::vector<Input>>(const Estimator&, const std::vector<Input>&,
+                                                               std::size_t)>;
+inline Snapshot find_snapshot(const std::string& name, const EstimatorConfig& config, const BeaconMap& map,
+                              const std::vector<Input>& inputs, double warmup_s, const StepAt& step_at) {
+  auto e = EstimatorRegistry::instance().create(name, config);
+  e->set_beacon_map(map);
+  Pose2 truth = Pose2::Zero();
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    push(*e, inputs[k]);
+    if (inputs[k].kind == Input::Kind::kOdometry) truth = inputs[k].truth;
+    if (inputs[k].stamp_ns < s_to_ns(warmup_s)) continue;
+    if (auto step = step_at(*e, inputs, k)) return {e->clone(), std::move(*step), truth};
+  }
+  throw std::logic_error(name + ": no snapshot as the benchmark wants in the simulated run");
+}
+
+inline std::size_t count(const std::vector<Input>& step, Input::Kind kind) {
+  std::size_t n = 0;
+  for (const Input& in : step) n += in.kind == kind ? 1 : 0;
+  return n;
+}
+
+// Every input of the step accepted, on a copy of the snapshot (a benchmark of refused inputs
+// would time the checks only).
+inline void require_accepted(const Snapshot& s, const std::string& what) {
+  auto e = s.estimator->clone();
+  for (const Input& in : s.step) {
+    const InputResult r = push(*e, in);
+    if (!r.accepted) throw std::logic_error(what + ": input refused (" + r.rejection + ")");
+  }
+  for (const auto& r : e->take_deferred_rejections()) throw std::logic_error(what + ": deferred " + r);
+}
+
+// One timed step: its inputs pushed in order. Out of line, so that a profiler can count it alone
+// (valgrind --tool=callgrind --collect-atstart=no --toggle-collect='beaconloc::bench::run_step*').
+[[gnu::noinline]] inline void run_step(Estimator& e, const std::vector<Input>& step) {
+  for (const Input& in : step) {
+    InputResult r = push(e, in);
+    benchmark::DoNotOptimize(r);
+  }
+}
+
+// Times the step's inputs, each iteration on its own copy of the snapshot. The copies are made
+// outside the timing, a batch at a time (PauseTiming costs about a microsecond: once per batch).
+inline void time_step(benchmark::State& state, const Snapshot& s) {
+  constexpr std::size_t kBatch = 128;
+  std::vector<std::unique_ptr<Estimator>> copies(kBatch);
+  std::size_t next = kBatch;
+  for (auto _ : state) {
+    if (next == kBatch) {
+      state.PauseTiming();
+      for (auto& c : copies) c = s.estimator->clone();
+      next = 0;
+      state.ResumeTiming();
+    }
+    run_step(*copies[next++], s.step);
+    benchmark::ClobberMemory();
+  }
+  state.counters["inputs_per_step"] = static_cast<double>(s.step.size());
+}
+
+}  // namespace beaconloc::bench
