@@ -5,22 +5,14 @@
 #include <array>
 #include <cmath>
 
+#include "distance_prediction.hpp"
+
 namespace beaconloc::duhl {
 namespace {
 
 // The receivers' positions in the robot frame (eq. 1): r_R [cos g_l, sin g_l], g_l = 2 pi (l-1) / 3
-// (the cosines and sines computed once: they sat in the UHL's hot loops).
-Eigen::Vector2d receiver_base(int l, double r_r) {
-  static const std::array<Eigen::Vector2d, 3> unit = [] {
-    std::array<Eigen::Vector2d, 3> u;
-    for (int k = 0; k < 3; ++k) {
-      const double g = 2.0 * M_PI * k / 3.0;
-      u[k] = {std::cos(g), std::sin(g)};
-    }
-    return u;
-  }();
-  return {r_r * unit[l].x(), r_r * unit[l].y()};
-}
+// (the ring the distance prediction uses too, its cosines and sines computed once).
+Eigen::Vector2d receiver_base(int l, double r_r) { return ReceiverRing{r_r, 0.0}.receiver(l); }
 
 // The line l_T through the Txs (principal axis of their planar positions): centroid, unit
 // normal, and the RMS spread across it.
