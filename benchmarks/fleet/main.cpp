@@ -123,9 +123,8 @@ int run_localizer(const dds::DdsOptions& dds, const std::string& self, int robot
   const auto sink_exit = sink ? sink->wait(std::chrono::seconds(10)) : std::optional<int>(0);
   decoder.wait(std::chrono::seconds(10));
   const std::string sink_log = sink ? sink->log() : std::string();
-  const double window_real_s = window_s;
   auto field = [&](const std::string& key) { return log_field(sink_log, key); };
-  const double expected_poses = robots * 100.0 * window_real_s;
+  const double expected_poses = robots * 100.0 * window_s;
   const double taken_ratio = static_cast<double>(end.odometry - begin.odometry) / expected_poses;
   const double pose_ratio = field("poses") / expected_poses;
   const double lag_growth_ms = lag_ms.empty() ? 0.0 : lag_ms.back() - lag_ms.front();
@@ -134,7 +133,7 @@ int run_localizer(const dds::DdsOptions& dds, const std::string& self, int robot
   const bool real_time =
       feeder_exit == 0 && sink_exit == 0 && delivered && lost == 0.0 && lag_growth_ms < 50.0;
 
-  const double cpu_pct = 100.0 * (end.cpu_s - begin.cpu_s) / window_real_s;
+  const double cpu_pct = 100.0 * (end.cpu_s - begin.cpu_s) / window_s;
   Results r(with_sink ? "fleet" : "fleet_no_sink", "robots=" + std::to_string(robots));
   r.add("robots", robots, "count");
   r.add("localizer_cpu", cpu_pct, "%core");
@@ -144,7 +143,7 @@ int run_localizer(const dds::DdsOptions& dds, const std::string& self, int robot
   r.add("localizer_rss_without_robots", rss_participant_mb, "MB");
   r.add("process_rss_before_dds", rss_empty_mb, "MB");
   r.add("odometry_taken_ratio", taken_ratio, "ratio");
-  r.add("poses_written_per_s", static_cast<double>(end.poses - begin.poses) / window_real_s, "1/s");
+  r.add("poses_written_per_s", static_cast<double>(end.poses - begin.poses) / window_s, "1/s");
   r.add("odometry_poses_received_ratio", pose_ratio, "ratio");
   r.add("corrections_received", field("corrections"), "count");
   r.add("lost_increments", lost, "count");
@@ -152,10 +151,10 @@ int run_localizer(const dds::DdsOptions& dds, const std::string& self, int robot
   r.add("pose_age_p99", field("age_p99_ms"), "ms");
   r.add("pose_age_max", field("age_max_ms"), "ms");
   r.add("odometry_lag_growth", lag_growth_ms, "ms");
-  r.add("feeder_cpu", 100.0 * feeder_cpu / window_real_s, "%core");
+  r.add("feeder_cpu", 100.0 * feeder_cpu / window_s, "%core");
   r.add("feeder_late_max", log_field(feeder.log(), "late_ms"), "ms");
-  r.add("decoder_cpu", 100.0 * decoder_cpu / window_real_s, "%core");
-  r.add("sink_cpu", 100.0 * sink_cpu / window_real_s, "%core");
+  r.add("decoder_cpu", 100.0 * decoder_cpu / window_s, "%core");
+  r.add("sink_cpu", 100.0 * sink_cpu / window_s, "%core");
   r.add("real_time", real_time ? 1.0 : 0.0, "bool");
   r.print();
   if (!csv.empty()) r.append_csv(csv);

@@ -14,6 +14,7 @@
 #include "beaconloc/dds/convert.hpp"
 #include "diagnostics_recorder.hpp"
 #include "domain_id.hpp"
+#include "participants_test.hpp"
 #include "process.hpp"
 #include "sim/scenario.hpp"
 
@@ -22,28 +23,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::uint64_t count_of(const msg::Diagnostics& d, const std::string& reason) {
-  for (const auto& r : d.rejected()) {
-    if (r.reason() == reason) return r.count();
-  }
-  return 0;
-}
-
-class BadInput : public ::testing::Test {
+class BadInput : public ParticipantsTest {
  protected:
-  void SetUp() override {
-    char dir[] = "/tmp/beaconloc-bad-input-XXXXXX";
-    ASSERT_NE(::mkdtemp(dir), nullptr);
-    dir_ = dir;
-    dds_.domain_id = domain_.id();
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
-  std::vector<std::string> command(const std::string& sub, std::vector<std::string> extra = {}) {
-    std::vector<std::string> argv{BEACONLOC_EXECUTABLE, sub, "--domain", std::to_string(domain_.id())};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    return argv;
-  }
   // The participant's diagnostics once they show `accepted` samples accepted (or a timeout).
   static msg::Diagnostics diagnostics_of(const DiagnosticsRecorder& recorder, const std::string& name,
                                          std::uint64_t accepted) {
@@ -59,10 +40,6 @@ class BadInput : public ::testing::Test {
     }
     return d;
   }
-
-  DomainLease domain_;
-  dds::DdsOptions dds_;
-  std::string dir_;
 };
 
 TEST_F(BadInput, DecoderRefusesEveryBadTofByReason) {
@@ -111,14 +88,14 @@ TEST_F(BadInput, DecoderRefusesEveryBadTofByReason) {
   const auto d = diagnostics_of(diagnostics, "beaconloc.decoder", 4);
   print_diagnostics({{"beaconloc.decoder", d}}, std::cout);
   EXPECT_EQ(d.accepted(), 4u);
-  EXPECT_EQ(count_of(d, "non_finite_tof"), 2u);
-  EXPECT_EQ(count_of(d, "negative_tof"), 1u);
-  EXPECT_EQ(count_of(d, "out_of_range_tof"), 1u);
-  EXPECT_EQ(count_of(d, "bad_temperature"), 1u);
-  EXPECT_EQ(count_of(d, "unknown_beacon"), 1u);
-  EXPECT_EQ(count_of(d, "duplicate"), 1u);
-  EXPECT_EQ(count_of(d, "stale"), 1u);
-  EXPECT_EQ(count_of(d, "time_jump"), 1u);
+  EXPECT_EQ(rejected_count(d, "non_finite_tof"), 2u);
+  EXPECT_EQ(rejected_count(d, "negative_tof"), 1u);
+  EXPECT_EQ(rejected_count(d, "out_of_range_tof"), 1u);
+  EXPECT_EQ(rejected_count(d, "bad_temperature"), 1u);
+  EXPECT_EQ(rejected_count(d, "unknown_beacon"), 1u);
+  EXPECT_EQ(rejected_count(d, "duplicate"), 1u);
+  EXPECT_EQ(rejected_count(d, "stale"), 1u);
+  EXPECT_EQ(rejected_count(d, "time_jump"), 1u);
   decoder.signal(SIGTERM);
   const auto code = decoder.wait(15s);
   ASSERT_TRUE(code);
@@ -202,19 +179,19 @@ TEST_F(BadInput, LocalizerRefusesEveryBadSampleByReason) {
   const auto d = diagnostics_of(diagnostics, "beaconloc.localizer.range_ekf", good_odometry + 1);
   print_diagnostics({{"localizer", d}}, std::cout);
   EXPECT_EQ(d.accepted(), good_odometry + 1);
-  EXPECT_EQ(count_of(d, "odometry.duplicate_odometry"), 1u);
-  EXPECT_EQ(count_of(d, "odometry.out_of_order_odometry"), 1u);
-  EXPECT_EQ(count_of(d, "odometry.non_finite_odometry"), 1u);
-  EXPECT_EQ(count_of(d, "odometry.invalid_wheel_base"), 1u);
-  EXPECT_EQ(count_of(d, "odometry.other_robot"), 1u);
-  EXPECT_EQ(count_of(d, "odometry.lost_increment"), 3u);
-  EXPECT_EQ(count_of(d, "range.non_finite_range"), 1u);
-  EXPECT_EQ(count_of(d, "range.invalid_range"), 1u);
-  EXPECT_EQ(count_of(d, "range.unknown_beacon"), 1u);
-  EXPECT_EQ(count_of(d, "range.unknown_receiver"), 1u);
-  EXPECT_EQ(count_of(d, "range.unassociated_range"), 1u);
-  EXPECT_EQ(count_of(d, "range.too_late"), 1u);
-  EXPECT_EQ(count_of(d, "range.ahead_of_odometry"), 1u);
+  EXPECT_EQ(rejected_count(d, "odometry.duplicate_odometry"), 1u);
+  EXPECT_EQ(rejected_count(d, "odometry.out_of_order_odometry"), 1u);
+  EXPECT_EQ(rejected_count(d, "odometry.non_finite_odometry"), 1u);
+  EXPECT_EQ(rejected_count(d, "odometry.invalid_wheel_base"), 1u);
+  EXPECT_EQ(rejected_count(d, "odometry.other_robot"), 1u);
+  EXPECT_EQ(rejected_count(d, "odometry.lost_increment"), 3u);
+  EXPECT_EQ(rejected_count(d, "range.non_finite_range"), 1u);
+  EXPECT_EQ(rejected_count(d, "range.invalid_range"), 1u);
+  EXPECT_EQ(rejected_count(d, "range.unknown_beacon"), 1u);
+  EXPECT_EQ(rejected_count(d, "range.unknown_receiver"), 1u);
+  EXPECT_EQ(rejected_count(d, "range.unassociated_range"), 1u);
+  EXPECT_EQ(rejected_count(d, "range.too_late"), 1u);
+  EXPECT_EQ(rejected_count(d, "range.ahead_of_odometry"), 1u);
   localizer.signal(SIGTERM);
   const auto code = localizer.wait(15s);
   ASSERT_TRUE(code);

@@ -11,6 +11,7 @@
 
 #include "diagnostics_recorder.hpp"
 #include "domain_id.hpp"
+#include "participants_test.hpp"
 #include "pose_recorder.hpp"
 #include "process.hpp"
 
@@ -19,31 +20,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
-class Pipeline : public ::testing::Test {
+class Pipeline : public ParticipantsTest {
  protected:
-  void SetUp() override {
-    char dir[] = "/tmp/beaconloc-pipeline-XXXXXX";
-    ASSERT_NE(::mkdtemp(dir), nullptr);
-    dir_ = dir;
-    dds_.domain_id = domain_.id();
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
-  std::vector<std::string> command(const std::string& sub, std::vector<std::string> extra = {}) {
-    std::vector<std::string> argv{BEACONLOC_EXECUTABLE, sub, "--domain", std::to_string(domain_.id())};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    return argv;
-  }
-  std::string path(const std::string& name) const { return dir_ + "/" + name; }
-
-  // Stops a participant the way an operator does, and expects a clean exit.
-  static void stop_cleanly(ChildProcess& p, const char* name) {
-    p.signal(SIGTERM);
-    const auto code = p.wait(15s);
-    ASSERT_TRUE(code) << name << " did not stop on SIGTERM";
-    EXPECT_EQ(*code, 0) << name << " log:\n" << p.log();
-  }
-
   // Waits for the gateway to finish its run, lets the last samples through, stops the others.
   static void finish_run(ChildProcess& gateway, ChildProcess& decoder, ChildProcess& localizer) {
     const auto gateway_code = gateway.wait(90s);
@@ -53,10 +31,6 @@ class Pipeline : public ::testing::Test {
     stop_cleanly(decoder, "decoder");
     stop_cleanly(localizer, "localizer");
   }
-
-  DomainLease domain_;
-  dds::DdsOptions dds_;
-  std::string dir_;
 };
 
 TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {

@@ -19,6 +19,7 @@
 #include "beaconloc/dds/wall_clock.hpp"
 #include "diagnostics_recorder.hpp"
 #include "domain_id.hpp"
+#include "participants_test.hpp"
 #include "pose_recorder.hpp"
 #include "process.hpp"
 
@@ -53,39 +54,9 @@ class RangeRecorder {
   dds::Participant participant_;
 };
 
-std::uint64_t rejected(const msg::Diagnostics& d, const std::string& reason) {
-  for (const auto& r : d.rejected()) {
-    if (r.reason() == reason) return r.count();
-  }
-  return 0;
-}
-
-class Qos : public ::testing::Test {
+class Qos : public ParticipantsTest {
  protected:
-  void SetUp() override {
-    char dir[] = "/tmp/beaconloc-qos-XXXXXX";
-    ASSERT_NE(::mkdtemp(dir), nullptr);
-    dir_ = dir;
-    dds_.domain_id = domain_.id();
-    dds_.participant_profile = "beaconloc.loopback_udp";
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
-  std::vector<std::string> command(const std::string& sub, std::vector<std::string> extra = {}) {
-    std::vector<std::string> argv{
-        BEACONLOC_EXECUTABLE,    sub, "--domain", std::to_string(domain_.id()), "--participant-profile",
-        dds_.participant_profile};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    return argv;
-  }
-  std::string path(const std::string& name) const { return dir_ + "/" + name; }
-
-  static void stop_cleanly(ChildProcess& p, const char* name) {
-    p.signal(SIGTERM);
-    const auto code = p.wait(15s);
-    ASSERT_TRUE(code) << name << " did not stop on SIGTERM";
-    EXPECT_EQ(*code, 0) << name << " log:\n" << p.log();
-  }
+  Qos() : ParticipantsTest("beaconloc.loopback_udp") {}
   static bool running(const ChildProcess& p) { return ::kill(p.pid(), 0) == 0; }
 
   // The stamp the gateway gave source time 0: its first odometry sample is at 10 ms.
@@ -97,10 +68,6 @@ class Qos : public ::testing::Test {
     if (!t) return -1.0;
     return (t->pose_map_base.head<2>() - p.row.estimate.pose_map_base.head<2>()).norm();
   }
-
-  DomainLease domain_;
-  dds::DdsOptions dds_;
-  std::string dir_;
 };
 
 // raw_tof and beacon_range deadline (400 ms, two slots): a gateway that stops publishing TOFs
@@ -306,14 +273,14 @@ TEST_F(Qos, OdometryHistoryCoversAStalledLocalizerAndLostIncrementsAreCounted) {
   ASSERT_EQ(after_short.count("beaconloc.localizer.range_ekf"), 1u);
   const auto& short_stalls = after_short.at("beaconloc.localizer.range_ekf");
   const auto& long_stall = after_long.at("beaconloc.localizer.range_ekf");
-  const std::uint64_t lost_short = rejected(short_stalls, "odometry.lost_increment");
-  const std::uint64_t lost_long = rejected(long_stall, "odometry.lost_increment");
+  const std::uint64_t lost_short = rejected_count(short_stalls, "odometry.lost_increment");
+  const std::uint64_t lost_long = rejected_count(long_stall, "odometry.lost_increment");
   std::printf(
       "localizer stalled 5 x 300 ms: %llu increments lost, %llu samples accepted; then 1.5 s: %llu lost\n",
       static_cast<unsigned long long>(lost_short), static_cast<unsigned long long>(short_stalls.accepted()),
       static_cast<unsigned long long>(lost_long));
   EXPECT_EQ(lost_short, 0u);
-  EXPECT_EQ(rejected(short_stalls, "odometry.odometry_gap"), 0u);
+  EXPECT_EQ(rejected_count(short_stalls, "odometry.odometry_gap"), 0u);
   EXPECT_GT(short_stalls.accepted(), 800u);  // > 8 s of 100 Hz odometry
   // 1.5 s is three times the history: what the bus could not hold is counted, not hidden.
   EXPECT_LE(lost_long, 150u);
