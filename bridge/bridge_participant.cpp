@@ -3,6 +3,7 @@
 #include <beaconlocPubSubTypes.h>
 
 #include <cctype>
+#include <cmath>
 #include <stdexcept>
 
 #include "beaconloc/dds/convert.hpp"
@@ -121,6 +122,10 @@ void BridgeParticipant::on_pose(const msg::PoseEstimate& m) {
   if (m.robot_id() != options_.robot_id) return;
   const PoseEstimate e = dds::from_msg(m);
   std::lock_guard<std::mutex> lock(mutex_);
+  if (!publishable(e)) {
+    counts_.reject("pose.unusable");  // a non-finite number never reaches ROS 2
+    return;
+  }
   if (e.status == PoseStatus::kInitializing || e.status == PoseStatus::kLost) {
     counts_.reject("pose.not_localized");  // as amcl: no pose, no map -> odom until localized
     return;
@@ -167,8 +172,14 @@ void BridgeParticipant::on_odometry(const msg::Odometry& m) {
 }
 
 void BridgeParticipant::on_beacon_map(const msg::BeaconMap& m) {
-  auto markers = beacon_markers(dds::from_msg(m), options_.map_frame, dds::wall_clock_ns());
+  BeaconMapCheck check;
+  const std::optional<BeaconMap> map = BeaconMap::from(dds::from_msg(m), &check);
   std::lock_guard<std::mutex> lock(mutex_);
+  if (!map) {
+    counts_.reject(std::string("beacon_map.") + to_string(check.problem));
+    return;
+  }
+  auto markers = beacon_markers(*map, options_.map_frame, dds::wall_clock_ns());
   beacons_writer_->write(&markers);
 }
 
@@ -178,6 +189,10 @@ void BridgeParticipant::on_range(const msg::BeaconRange& m) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (r.receiver_id >= options_.receivers.size()) {
     counts_.reject("range.unknown_receiver");
+    return;
+  }
+  if (!std::isfinite(r.range_m) || !(r.range_m >= 0.0) || !std::isfinite(r.variance_m2)) {
+    counts_.reject("range.unusable");
     return;
   }
   auto range = to_ros_range(r, "receiver_" + std::to_string(r.receiver_id), options_.range_field_of_view_rad,

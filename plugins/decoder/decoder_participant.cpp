@@ -15,7 +15,7 @@ DecoderParticipant::DecoderParticipant(const dds::DdsOptions& dds, TofDecoderCon
     std::vector<DecodedRange> held;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      held = decoder_.set_beacon_map(dds::from_msg(m));
+      held = decoder_.on_beacon_map(dds::from_msg(m));
     }
     for (const auto& range : held) publish(range);
   });

@@ -93,6 +93,16 @@ DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample
   return decode_with_map(robot_id, tof, range_m);
 }
 
+std::vector<DecodedRange> TofDecoder::on_beacon_map(const std::vector<Beacon>& beacons) {
+  BeaconMapCheck check;
+  const std::optional<BeaconMap> map = BeaconMap::from(beacons, &check);
+  if (!map) {
+    counts_.reject(std::string("beacon_map.") + to_string(check.problem));
+    return {};
+  }
+  return set_beacon_map(*map);
+}
+
 std::vector<DecodedRange> TofDecoder::set_beacon_map(const BeaconMap& map) {
   map_ = map;
   std::vector<DecodedRange> ranges;

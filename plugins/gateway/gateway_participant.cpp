@@ -2,8 +2,10 @@
 
 #include <beaconlocPubSubTypes.h>
 
+#include <algorithm>
 #include <chrono>
 #include <iomanip>
+#include <sstream>
 #include <stdexcept>
 
 #include "beaconloc/dds/convert.hpp"
@@ -23,7 +25,13 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
       tof_writer_(participant_.writer<msg::RawTofPubSubType>(dds::kRawTofTopic)),
       odometry_writer_(participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic)),
       scan_writer_(participant_.writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic)) {
-  if (!(options_.speed >= 0.0)) throw std::invalid_argument("--speed must be >= 0");
+  if (!(options_.speed == 0.0 ||
+        (options_.speed >= GatewayOptions::kMinSpeed && options_.speed <= GatewayOptions::kMaxSpeed))) {
+    std::ostringstream why;
+    why << "--speed must be 0 (as fast as it goes) or within [" << GatewayOptions::kMinSpeed << ", "
+        << GatewayOptions::kMaxSpeed << "], got " << options_.speed;
+    throw std::invalid_argument(why.str());
+  }
   if (!(options_.duration_s >= 0.0)) throw std::invalid_argument("--duration-s must be >= 0");
   if (!options_.truth_csv.empty()) {
     truth_.open(options_.truth_csv);
@@ -79,7 +87,11 @@ void GatewayParticipant::start() {
 }
 
 void GatewayParticipant::stop() {
-  stop_ = true;
+  {
+    std::lock_guard<std::mutex> lock(stop_mutex_);
+    stop_ = true;
+  }
+  stop_cv_.notify_all();
   if (thread_.joinable()) thread_.join();
 }
 
@@ -168,9 +180,13 @@ void GatewayParticipant::run() {
     events.clear();
     source_->advance(bounded ? std::min(t_ns, last_ns) : t_ns, events);
     if (options_.speed > 0.0) {
-      const auto wall_offset = std::chrono::nanoseconds(
-          static_cast<StampNs>(static_cast<double>(t_ns - begin_ns) / options_.speed));
-      std::this_thread::sleep_until(wall_start + wall_offset);
+      // Capped at 30 years of waiting (a recording of absurd length at the slowest speed), so
+      // that the offset is a representable time whatever the stamps.
+      const double wait_s = std::min(ns_to_s(t_ns - begin_ns) / options_.speed, 1e9);
+      const auto wall_offset =
+          std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(wait_s));
+      std::unique_lock<std::mutex> lock(stop_mutex_);
+      if (stop_cv_.wait_until(lock, wall_start + wall_offset, [this] { return stop_.load(); })) break;
     }
     for (auto& e : events) publish(e, offset_ns);
     elapsed_s_ = ns_to_s(std::min(t_ns, bounded ? last_ns : t_ns) - begin_ns);

@@ -4,6 +4,7 @@
 // throttle lets it; writes the source's ground truth to a CSV when asked.
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <fstream>
 #include <functional>
@@ -24,6 +25,11 @@ struct GatewayOptions {
   std::string robot_id = "robot1";
   double duration_s = 0.0;  // seconds of source time to run; 0 = the whole source / until stopped
   double speed = 1.0;       // source seconds per wall second; 0 = as fast as the throttle allows
+  // Paced speeds from 1000x slower than real time (a day of wall time for 86 s of data) to 10^4x
+  // faster (beyond, the pipeline cannot keep up and pacing means nothing): --speed is refused
+  // outside them, so that the wall-clock offset of any stamp is a finite, representable time.
+  static constexpr double kMinSpeed = 1e-3;
+  static constexpr double kMaxSpeed = 1e4;
   std::uint64_t seed = 1;
   std::string truth_csv;  // ground truth written here when not empty
   // The samples written, as CSV (tof.csv, odometry.csv, with the simulator's hidden truth: who
@@ -92,6 +98,9 @@ class GatewayParticipant {
   std::atomic<double> elapsed_s_{0.0};
   double total_s_ = 0.0;
   std::atomic<bool> stop_{false};
+  // stop() wakes the pacing wait at once, however long it was to sleep.
+  std::mutex stop_mutex_;
+  std::condition_variable stop_cv_;
   std::atomic<bool> finished_{false};
   std::string failure_;
   std::thread thread_;

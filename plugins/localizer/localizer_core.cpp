@@ -12,9 +12,44 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
   uses_laser_ = EstimatorRegistry::instance().create(estimator_name_, config_)->uses_laser();
 }
 
+bool LocalizerCore::on_beacon_map(const std::vector<Beacon>& beacons) {
+  BeaconMapCheck check;
+  const std::optional<BeaconMap> map = BeaconMap::from(beacons, &check);
+  if (!map) {
+    counts_.reject(std::string("beacon_map.") + to_string(check.problem));
+    return false;
+  }
+  set_beacon_map(*map);
+  return true;
+}
+
 void LocalizerCore::set_beacon_map(const BeaconMap& map) {
+  if (map == map_) return;
+  const bool first = map_.empty();
   map_ = map;
-  for (auto& [id, r] : robots_) r.fusion.set_beacon_map(map_);
+  if (!first) ++beacon_map_changes_;
+  for (auto& [id, r] : robots_) {
+    if (first) {
+      r.fusion.set_beacon_map(map_);  // nothing it holds came from beacons yet
+    } else {
+      restart_robot(r);
+    }
+  }
+}
+
+InputResult LocalizerCore::restart_robot(Robot& r, const OdometrySample* next) {
+  const std::optional<PoseEstimate> before = r.fusion.estimator().estimate();
+  EstimatorConfig restart = config_;
+  restart.initial_pose.reset();  // not the run's start pose
+  r = Robot(EstimatorRegistry::instance().create(estimator_name_, restart));
+  r.fusion.set_beacon_map(map_);
+  const InputResult result = next ? r.fusion.predict(*next) : InputResult::ok();
+  if (!r.fusion.estimator().localizes_from_beacons() && before && publishable(*before) && result.accepted) {
+    // Placed where it was, less sure by 0.1 m and 0.1 rad (standard deviations).
+    const Cov3 inflated = before->covariance + Eigen::Vector3d(0.01, 0.01, 0.01).asDiagonal().toDenseMatrix();
+    r.fusion.reset(next ? next->stamp_ns : before->stamp_ns, before->pose_map_base, inflated);
+  }
+  return result;
 }
 
 LocalizerCore::Robot* LocalizerCore::robot(const std::string& robot_id, const char* kind) {
@@ -43,21 +78,11 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
   for (const auto& reason : r->fusion.take_deferred_rejections()) counts_.reject("deferred." + reason);
   if (!result.accepted && result.rejection == "out_of_order_odometry" && clock_jumped_back(*r, odometry)) {
     // The robot's clock stepped back (a restarted gateway replaying, a reset clock): what the
-    // estimator holds belongs to the old time line. A new one starts on the new time line, from
-    // where the robot was (a clock jump does not move it), less sure; an estimator that had no
-    // pose yet, or cannot be placed, finds it from the beacons.
+    // estimator holds belongs to the old time line. A new one starts on the new time line
+    // (restart_robot: re-localized from the beacons; the old pose is no evidence of where the
+    // robot is now, a replay starts again where the robot was back then).
     counts_.reject("odometry.clock_jumped_back");
-    const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
-    EstimatorConfig restart = config_;
-    restart.initial_pose.reset();  // not the run's start pose
-    *r = Robot(EstimatorRegistry::instance().create(estimator_name_, restart));
-    r->fusion.set_beacon_map(map_);
-    result = r->fusion.predict(odometry);
-    if (before && result.accepted) {
-      const Cov3 inflated =
-          before->covariance + Eigen::Vector3d(0.01, 0.01, 0.01).asDiagonal().toDenseMatrix();
-      r->fusion.reset(odometry.stamp_ns, before->pose_map_base, inflated);
-    }
+    result = restart_robot(*r, &odometry);
   }
   if (!result.accepted) {
     counts_.reject("odometry." + result.rejection);
@@ -71,6 +96,13 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
 std::optional<LocalizerOutput> LocalizerCore::output(const std::string& robot_id, Robot& r) {
   auto estimate = r.fusion.estimator().estimate();
   if (!estimate) return std::nullopt;
+  if (!publishable(*estimate)) {
+    // Never published: an estimate with a non-finite number or a broken covariance. The
+    // estimator that made it cannot be trusted either: the robot starts again from the beacons.
+    counts_.reject("estimate.unusable");
+    restart_robot(r);
+    return std::nullopt;
+  }
   estimate->status = r.status();
   LocalizerOutput out{robot_id, *estimate, {r.beacons_used.begin(), r.beacons_used.end()}};
   r.beacons_used.clear();

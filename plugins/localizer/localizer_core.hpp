@@ -27,8 +27,15 @@ class LocalizerCore {
   // every robot on the topics; otherwise samples of other robots are ignored (and counted).
   LocalizerCore(std::string estimator_name, EstimatorConfig config, std::string robot_filter = {});
 
+  // A beacon map as received (the bus): refused whole, counted as beacon_map.<reason>, when
+  // check_beacons refuses it; the map in use is kept then. Returns whether it was taken.
+  bool on_beacon_map(const std::vector<Beacon>& beacons);
+  // The first map is given to every robot's estimator; the same map again (a restarted gateway)
+  // changes nothing; a different one (beacons moved, added or gone) restarts every robot on it:
+  // what an estimator holds was measured against the old beacons (restart_robot).
   void set_beacon_map(const BeaconMap& map);
   bool has_beacon_map() const { return !map_.empty(); }
+  std::uint64_t beacon_map_changes() const { return beacon_map_changes_; }
   // Predicts; returns the pose to publish once the robot's estimator has one.
   std::optional<LocalizerOutput> on_odometry(const std::string& robot_id, const OdometrySample& odometry);
   // Corrects; returns the corrected pose when the measurement changed the estimate, so that it
@@ -74,6 +81,14 @@ class LocalizerCore {
   static constexpr StampNs kClockJumpMinNs = kNsPerSecond;
   static constexpr StampNs kClockJumpConfirmationNs = 200 * kNsPerMillisecond;
   bool clock_jumped_back(Robot& r, const OdometrySample& odometry);
+  // A new estimator for the robot, on the current map: what the old one holds no longer holds
+  // (the clock went back, the beacons changed, its estimate became unusable). An estimator that
+  // finds its pose from the beacons starts from nothing, initializing until it has a fix: the
+  // old pose cannot be trusted (a replayed recording starts where the robot was then, not where
+  // it is). One that must be placed (localizes_from_beacons() false) is placed at the old pose,
+  // less sure, as no better guess exists. `next`, when given, is the odometry sample the new
+  // estimator starts its time line with (a clock jump): its result is returned.
+  InputResult restart_robot(Robot& r, const OdometrySample* next = nullptr);
   Robot* robot(const std::string& robot_id, const char* kind);
   // The robot's pose to publish (none before its first fix), with the beacons fused since the last.
   std::optional<LocalizerOutput> output(const std::string& robot_id, Robot& r);
@@ -87,6 +102,7 @@ class LocalizerCore {
   BeaconMap map_;
   std::map<std::string, Robot> robots_;
   RejectionCounter counts_;
+  std::uint64_t beacon_map_changes_ = 0;
 };
 
 }  // namespace beaconloc

@@ -15,7 +15,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       pose_writer_(participant_.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic)) {
   participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [this](const msg::BeaconMap& m) {
     std::lock_guard<std::mutex> lock(mutex_);
-    core_.set_beacon_map(dds::from_msg(m));
+    core_.on_beacon_map(dds::from_msg(m));
   });
   // A robot whose ranges miss their deadline (two beacon slots) coasts on odometry, degraded.
   dds::ReaderEvents<msg::BeaconRange> range_events;

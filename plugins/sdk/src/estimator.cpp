@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "beaconloc/core/estimator_registry.hpp"
+#include "beaconloc/core/limits.hpp"
 
 namespace beaconloc {
 
@@ -21,6 +22,12 @@ const char* to_string(PoseStatus s) {
       return "lost";
   }
   return "unknown";
+}
+
+bool publishable(const PoseEstimate& e) {
+  return e.pose_map_base.allFinite() && e.covariance.allFinite() &&
+         e.covariance.isApprox(e.covariance.transpose(), 1e-9) &&
+         (e.covariance.diagonal().array() >= 0.0).all();
 }
 
 std::map<std::string, double> parse_estimator_parameters(const std::vector<std::string>& items,
@@ -46,6 +53,9 @@ InputResult check_range(const RangeMeasurement& r, const BeaconMap& map, std::si
   if (!std::isfinite(r.range_m) || !std::isfinite(r.variance_m2))
     return InputResult::rejected("non_finite_range");
   if (!(r.range_m > 0.0) || !(r.variance_m2 > 0.0)) return InputResult::rejected("invalid_range");
+  if (r.range_m > kMaxRangeM || r.variance_m2 > kMaxRangeM * kMaxRangeM)
+    return InputResult::rejected("implausible_range");
+  if (r.stamp_ns < 0) return InputResult::rejected("invalid_stamp");
   if (r.beacon_id == kBeaconUnidentified) return InputResult::rejected("unassociated_range");
   if (map.empty()) return InputResult::rejected("no_beacon_map");
   if (!map.find(r.beacon_id)) return InputResult::rejected("unknown_beacon");

@@ -2,7 +2,19 @@
 
 #include <cmath>
 
+#include "beaconloc/core/limits.hpp"
+
 namespace beaconloc {
+
+namespace {
+// Symmetric, positive semi-definite (non-negative variances and determinant), and no variance
+// beyond the square of the largest speed there is (a standard deviation over 10 m/s says nothing).
+bool valid_covariance(const Eigen::Matrix2d& c) {
+  const double max_variance = kMaxWheelSpeedMps * kMaxWheelSpeedMps;
+  return c(0, 1) == c(1, 0) && c(0, 0) >= 0.0 && c(1, 1) >= 0.0 && c(0, 0) <= max_variance &&
+         c(1, 1) <= max_variance && c(0, 0) * c(1, 1) - c(0, 1) * c(1, 0) >= 0.0;
+}
+}  // namespace
 
 OdometryTimeline::Step OdometryTimeline::advance(const OdometrySample& o) {
   Step step;
@@ -10,9 +22,17 @@ OdometryTimeline::Step OdometryTimeline::advance(const OdometrySample& o) {
                       std::isfinite(o.wheel_base_m) && o.wheel_velocity_covariance.allFinite();
   if (!finite) {
     step.result = InputResult::rejected("non_finite_odometry");
+  } else if (o.stamp_ns < 0) {
+    step.result = InputResult::rejected("invalid_stamp");
   } else if (!(o.wheel_base_m > 0.0)) {
     step.result = InputResult::rejected("invalid_wheel_base");
-  } else if ((o.wheel_velocity_covariance.diagonal().array() < 0.0).any()) {
+  } else if (o.wheel_base_m > kMaxWheelBaseM) {
+    step.result = InputResult::rejected("implausible_wheel_base");
+  } else if (std::abs(o.wheel_velocity_right_mps) > kMaxWheelSpeedMps ||
+             std::abs(o.wheel_velocity_left_mps) > kMaxWheelSpeedMps) {
+    // Integrated, 1e300 m/s puts the pose at 1e298 m; 1000 m/s jumps it 10 m a sample.
+    step.result = InputResult::rejected("implausible_wheel_speed");
+  } else if (!valid_covariance(o.wheel_velocity_covariance)) {
     step.result = InputResult::rejected("invalid_odometry_covariance");
   } else if (!last_stamp_ns_) {
     last_stamp_ns_ = o.stamp_ns;  // the anchor of the time line

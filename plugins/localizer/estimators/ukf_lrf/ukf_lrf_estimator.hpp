@@ -45,6 +45,8 @@ class UkfLrf final : public Estimator {
   UkfLrf(const EstimatorConfig& config, Mode mode);
   std::string name() const override;
   void set_beacon_map(const BeaconMap& map) override { map_ = map; }
+  // Placed by hand (seed 001 Sec. 4.1): anonymous ranges cannot give a first pose.
+  bool localizes_from_beacons() const override { return false; }
   InputResult predict(const OdometrySample& odometry) override;
   InputResult update(const RangeMeasurement& range) override;
   bool uses_laser() const override { return mode_ != Mode::kBeaconsOnly; }

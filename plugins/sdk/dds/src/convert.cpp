@@ -82,12 +82,13 @@ msg::LaserScan to_msg(const std::string& robot_id, const LaserScanSample& s) {
   return m;
 }
 
-BeaconMap from_msg(const msg::BeaconMap& m) {
+std::vector<Beacon> from_msg(const msg::BeaconMap& m) {
   std::vector<Beacon> beacons;
+  beacons.reserve(m.beacons().size());
   for (const auto& b : m.beacons()) {
     beacons.push_back({b.id(), {b.x_m(), b.y_m(), b.z_m()}, b.group()});
   }
-  return BeaconMap(beacons);
+  return beacons;
 }
 
 msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id) {

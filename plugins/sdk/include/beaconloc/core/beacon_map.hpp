@@ -1,9 +1,19 @@
 #pragma once
-// The site's ceiling beacons at known positions in the map frame.
+// The site's ceiling beacons at known positions in the map frame, and the checks a list of
+// beacons must pass to become one: whatever its source (a scenario, a recording's beacons.csv,
+// a BeaconMap sample from the bus), a map with a repeated id, the reserved id or a position that
+// is not a finite number within kMaxBeaconCoordinateM of the origin is refused whole, with the
+// reason and the beacon that caused it; nothing is "repaired" (the first of two ids kept, a NaN
+// used).
 #include <Eigen/Core>
 #include <cstdint>
 #include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
+
+#include "beaconloc/core/measurements.hpp"
 
 namespace beaconloc {
 
@@ -13,12 +23,52 @@ struct Beacon {
   std::uint32_t group = 0;
 };
 
+// A beacon 10 km from the map origin is no indoor ceiling: the bound only catches absurd
+// numbers (1e300, a unit mix-up of 1000x), whose squares would overflow the range model.
+inline constexpr double kMaxBeaconCoordinateM = 1.0e4;
+// More beacons than any site has (a slot every 200 ms would take 13 min to fire them all): a
+// bound on what one sample may make the localizer and decoder hold.
+inline constexpr std::size_t kMaxBeacons = 4096;
+
+enum class BeaconMapProblem {
+  kNone,
+  kEmpty,               // no beacon at all
+  kTooManyBeacons,      // more than kMaxBeacons
+  kReservedId,          // kBeaconUnidentified is the id of an anonymous range
+  kDuplicateId,         // two beacons with one id
+  kNonFinitePosition,   // NaN or infinity in a coordinate
+  kPositionOutOfRange,  // a coordinate beyond kMaxBeaconCoordinateM
+};
+// Stable snake_case names (Diagnostics reasons: beacon_map.<name>).
+const char* to_string(BeaconMapProblem problem);
+
+struct BeaconMapCheck {
+  BeaconMapProblem problem = BeaconMapProblem::kNone;
+  std::uint32_t beacon_id = 0;  // the beacon that caused it, where one did
+  bool ok() const { return problem == BeaconMapProblem::kNone; }
+  std::string describe() const;  // "beacon 4: duplicate_id"
+};
+BeaconMapCheck check_beacons(const std::vector<Beacon>& beacons);
+
+// Thrown by BeaconMap(beacons) for a list that check_beacons refuses.
+class InvalidBeaconMap : public std::invalid_argument {
+ public:
+  explicit InvalidBeaconMap(const BeaconMapCheck& check)
+      : std::invalid_argument("invalid beacon map: " + check.describe()), check_(check) {}
+  const BeaconMapCheck& check() const { return check_; }
+
+ private:
+  BeaconMapCheck check_;
+};
+
 class BeaconMap {
  public:
   BeaconMap() = default;
-  explicit BeaconMap(const std::vector<Beacon>& beacons) {
-    for (const auto& b : beacons) beacons_[b.id] = b;
-  }
+  // Throws InvalidBeaconMap unless check_beacons(beacons).ok().
+  explicit BeaconMap(const std::vector<Beacon>& beacons);
+  // The map, or nullopt with the reason in *check: for input that may be bad (the bus).
+  static std::optional<BeaconMap> from(const std::vector<Beacon>& beacons, BeaconMapCheck* check);
+
   const Beacon* find(std::uint32_t id) const {
     auto it = beacons_.find(id);
     return it == beacons_.end() ? nullptr : &it->second;
@@ -30,6 +80,10 @@ class BeaconMap {
     for (const auto& [id, b] : beacons_) out.push_back(b);
     return out;
   }
+  // Same beacons at the same positions in the same groups (a gateway that restarts publishes
+  // the map again: that is no new map).
+  bool operator==(const BeaconMap& other) const;
+  bool operator!=(const BeaconMap& other) const { return !(*this == other); }
 
  private:
   std::map<std::uint32_t, Beacon> beacons_;  // ordered: deterministic iteration

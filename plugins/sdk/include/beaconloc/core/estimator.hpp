@@ -27,6 +27,10 @@ struct PoseEstimate {
   PoseStatus status = PoseStatus::kInitializing;
 };
 
+// Whether an estimate may go out: finite pose, and a symmetric covariance of finite,
+// non-negative variances. Every output path (localizer, bridge, monitor, files) holds to it.
+bool publishable(const PoseEstimate& estimate);
+
 // The answer to one pushed input: accepted, or rejected with a reason (counted in Diagnostics).
 struct InputResult {
   bool accepted = true;
@@ -58,7 +62,13 @@ class Estimator {
  public:
   virtual ~Estimator() = default;
   virtual std::string name() const = 0;
+  // Given once, before the first sample (or when the first map arrives after some): a map that
+  // changes later gets a new estimator (LocalizerCore::restart_robot), since what an estimator
+  // holds was measured against the beacons it had.
   virtual void set_beacon_map(const BeaconMap& map) = 0;
+  // Whether it finds its pose from the beacons alone; false for one that must be placed
+  // (given an initial pose): a restart then places it where it was.
+  virtual bool localizes_from_beacons() const { return true; }
   virtual InputResult predict(const OdometrySample& odometry) = 0;
   virtual InputResult update(const RangeMeasurement& range) = 0;
   // Laser scans, for the estimators that use them (uses_laser()); the others are never pushed one.

@@ -1,6 +1,7 @@
 #pragma once
 // The checks every estimator makes of an odometry sample before integrating it, and the time
-// line it keeps: finite values, a positive wheel base, a sane covariance, stamps that move
+// line it keeps: finite values within the physical bounds of core/limits.hpp (wheel speeds and
+// wheel base), a symmetric positive semi-definite covariance, non-negative stamps that move
 // forward, and no integration across a gap (the velocities describe only the last period).
 #include <optional>
 
