@@ -320,6 +320,7 @@ int run(int argc, char** argv) {
     }
     if (accuracy->parsed()) {
       std::vector<AccuracyRow> rows;
+      std::vector<std::string> failed_runs;
       const bool variants_compared = !accuracy_faults.empty() || accuracy_delay_ms > 0.0;
       for (const auto& file : accuracy_scenarios) {
         sim::Scenario clean = sim::load_scenario_file(file);
@@ -352,6 +353,12 @@ int run(int argc, char** argv) {
               const OfflineRunResult r =
                   run_scenario_offline(variant.scenario, accuracy_first_seed + static_cast<std::uint64_t>(k),
                                        estimator, accuracy_parameters, accuracy_settle_s, variant.delivery);
+              if (r.metrics.samples == 0) {  // a run that gave nothing is no 0 m: a failure
+                failed_runs.push_back(variant.label + ", " + estimator + ", seed " +
+                                      std::to_string(accuracy_first_seed + static_cast<std::uint64_t>(k)) +
+                                      ": " + std::to_string(r.poses) + " pose(s), none scored");
+                continue;
+              }
               row.runs.push_back(r.metrics);
               if (r.associations.total()) row.associations.push_back(r.associations);
               for (const auto& [reason, n] : r.rejections.rejected_by_reason()) row.rejections[reason] += n;
@@ -377,6 +384,13 @@ int run(int argc, char** argv) {
         std::ofstream out(accuracy_out);
         out << table;
         if (!out.flush()) throw std::runtime_error("writing '" + accuracy_out + "' failed");
+      }
+      if (!failed_runs.empty()) {
+        std::cerr << "beaconloc accuracy: " << failed_runs.size()
+                  << " run(s) gave no scored pose, left out of "
+                  << "the table:\n";
+        for (const auto& f : failed_runs) std::cerr << "- " << f << '\n';
+        return 1;
       }
       return 0;
     }
@@ -455,12 +469,21 @@ int run(int argc, char** argv) {
       std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe");
       const PipelineResult r = run_pipeline(o, std::move(source), self.string());
       std::cout << r.diagnostics;
-      std::printf("poses: %zu at %.1f Hz; %s\n", r.poses, r.pose_rate_hz, format_metrics(r.metrics).c_str());
+      // No pose at all is a failure; poses that no truth covers are a failure only where the
+      // source has truth (then the estimate and the truth do not overlap). A source without
+      // ground truth (a replay without gt.csv) gives poses that are not scored.
+      const bool has_truth = r.truth_samples > 0;
+      std::printf("poses: %zu at %.1f Hz; %s\n", r.poses, r.pose_rate_hz,
+                  has_truth ? format_metrics(r.metrics).c_str() : "no ground truth: not scored");
       if (!out_dir.empty())
         std::cout << "wrote " << out_dir
                   << "/{truth,estimate,beacons}.csv, metrics.json, trajectory.svg, error.svg\n";
-      if (r.metrics.samples == 0) {
-        std::cerr << "beaconloc: no pose was estimated\n";
+      if (r.poses == 0) {
+        std::cerr << "beaconloc: no pose was estimated (the localizer's last status is above)\n";
+        return 1;
+      }
+      if (has_truth && r.metrics.samples == 0) {
+        std::cerr << "beaconloc: no pose was at a stamp the ground truth covers\n";
         return 1;
       }
       return 0;

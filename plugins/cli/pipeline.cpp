@@ -135,6 +135,7 @@ PipelineResult finish(const PipelineOptions& o, const LoadedSource& source, cons
   r.poses = s.poses;
   r.pose_rate_hz = s.pose_rate_hz;
   r.metrics = s.metrics;
+  r.truth_samples = truth.size();
   r.diagnostics = diagnostics;
   if (!o.out_dir.empty()) {
     const auto rows = rows_of(poses);
@@ -474,6 +475,10 @@ Metrics evaluate_files(const std::string& truth_csv, const std::string& estimate
 }
 
 std::string format_metrics(const Metrics& m) {
+  if (m.samples == 0) {
+    return "not scored: no pose had ground truth at its stamp (" + std::to_string(m.samples_without_truth) +
+           " without)";
+  }
   char line[512];
   std::snprintf(
       line, sizeof line,

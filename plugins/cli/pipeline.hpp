@@ -73,7 +73,8 @@ struct PipelineResult {
   std::size_t poses = 0;
   double pose_rate_hz = 0.0;
   Metrics metrics;
-  std::string diagnostics;  // each participant's counts, one line each
+  std::size_t truth_samples = 0;  // 0: the source has no ground truth (a replay without gt.csv)
+  std::string diagnostics;        // each participant's counts, one line each
 };
 
 // Runs to the end of the source (or the duration), then evaluates. With out_dir, writes

@@ -212,17 +212,26 @@ void write_metrics_json(const std::string& path, const Metrics& m, const std::st
       s << "null";
     return s.str();
   };
+  // A figure is written only where something was scored: with no sample, every figure is null
+  // (a run that scored nothing has no error of 0 m). A figure that is not finite is never
+  // written: the evaluation refuses it, and the file is not left half-written.
+  const bool scored = m.samples > 0;
+  auto figure = [&](double v) { return scored ? std::optional<double>(v) : std::nullopt; };
+  for (const auto& v : {figure(m.position_rms_m), figure(m.position_mean_m), figure(m.position_max_m),
+                        m.heading_rms_deg, m.significant_points_mean_m, figure(m.nees_in_band_fraction)}) {
+    if (v && !std::isfinite(*v)) throw std::runtime_error("'" + path + "': a metric is not finite");
+  }
   out << std::setprecision(6) << "{\n"
       << "  \"estimator\": " << quoted(estimator) << ",\n"
       << "  \"source\": " << quoted(source) << ",\n"
       << "  \"samples\": " << m.samples << ",\n"
       << "  \"samples_without_truth\": " << m.samples_without_truth << ",\n"
-      << "  \"position_rms_m\": " << m.position_rms_m << ",\n"
-      << "  \"position_mean_m\": " << m.position_mean_m << ",\n"
-      << "  \"position_max_m\": " << m.position_max_m << ",\n"
+      << "  \"position_rms_m\": " << optional(figure(m.position_rms_m)) << ",\n"
+      << "  \"position_mean_m\": " << optional(figure(m.position_mean_m)) << ",\n"
+      << "  \"position_max_m\": " << optional(figure(m.position_max_m)) << ",\n"
       << "  \"heading_rms_deg\": " << optional(m.heading_rms_deg) << ",\n"
       << "  \"significant_points_mean_m\": " << optional(m.significant_points_mean_m) << ",\n"
-      << "  \"nees_in_band_fraction\": " << m.nees_in_band_fraction << ",\n"
+      << "  \"nees_in_band_fraction\": " << optional(figure(m.nees_in_band_fraction)) << ",\n"
       << "  \"nees_dof\": " << m.nees_dof << "\n"
       << "}\n";
   if (!out.flush()) throw std::runtime_error("writing '" + path + "' failed");

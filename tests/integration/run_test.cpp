@@ -104,6 +104,51 @@ TEST_F(Run, ReplaysTheTucFixture) {
   EXPECT_NE(metrics.find("\"heading_rms_deg\": null"), std::string::npos);  // the recording has no heading
 }
 
+// A replay without gt.csv (optional, docs/replay-format.md) is localized and its poses written,
+// not scored: no figure is made up and the run succeeds.
+TEST_F(Run, AReplayWithoutGroundTruthIsLocalizedAndNotScored) {
+  const std::string replay = dir_ + "/no_truth";
+  std::filesystem::copy(kSource + "/tests/data/tuc_labyrinth_30s", replay);
+  std::filesystem::remove(replay + "/gt.csv");
+  const auto [code, out] = beaconloc({"run", "--replay", replay, "--max-range-m", "10", "--range-sigma-m",
+                                      "0.15", "--param", "init_window_s=5", "--out", dir_ + "/out"});
+  ASSERT_EQ(code, 0) << out;
+  EXPECT_NE(out.find("no ground truth: not scored"), std::string::npos) << out;
+  const std::string metrics = read(dir_ + "/out/metrics.json");
+  EXPECT_EQ(json_number(metrics, "samples"), 0);
+  EXPECT_GT(json_number(metrics, "samples_without_truth"), 150);
+  EXPECT_NE(metrics.find("\"position_rms_m\": null"), std::string::npos) << metrics;
+}
+
+// A run that estimated no pose fails, says so, and scores nothing as 0 m.
+TEST_F(Run, ARunWithoutAnyPoseFailsAndScoresNothing) {
+  // Every range is refused by the decoder (the beacons hang 2 m up): the localizer never starts.
+  const auto [code, out] = beaconloc({"run", "--duration-s", "5", "--max-range-m", "0.5", "--out", dir_});
+  EXPECT_EQ(code, 1) << out;
+  EXPECT_NE(out.find("no pose was estimated"), std::string::npos) << out;
+  EXPECT_EQ(out.find("position RMS 0.000"), std::string::npos) << out;
+  const std::string metrics = read(dir_ + "/metrics.json");
+  EXPECT_NE(metrics.find("\"position_rms_m\": null"), std::string::npos) << metrics;
+  EXPECT_NE(metrics.find("\"nees_in_band_fraction\": null"), std::string::npos) << metrics;
+}
+
+// `accuracy` over seeds of which none gives a pose: a failure naming the runs, not 0.000 +- 0.000.
+TEST_F(Run, AccuracyOverRunsThatGaveNothingFails) {
+  std::ifstream in(kSource + "/examples/scenarios/default.yaml");
+  std::stringstream yaml;
+  yaml << in.rdbuf();
+  std::string text = yaml.str();
+  const std::string limit = "max_range_m: 5.0";
+  ASSERT_NE(text.find(limit), std::string::npos);
+  text.replace(text.find(limit), limit.size(), "max_range_m: 0.5");  // every beacon out of range
+  std::ofstream(dir_ + "/unreachable.yaml") << text;
+  const auto [code, out] = run_command(
+      {BEACONLOC_EXECUTABLE, "accuracy", "--scenario", dir_ + "/unreachable.yaml", "--seeds", "2"}, 120s);
+  EXPECT_EQ(code, 1) << out;
+  EXPECT_NE(out.find("2 run(s) gave no scored pose"), std::string::npos) << out;
+  EXPECT_EQ(out.find("0.000 +- 0.000"), std::string::npos) << out;
+}
+
 TEST_F(Run, OneProcessPerParticipant) {
   const auto [code, out] =
       beaconloc({"run", "--processes", "--speed", "4", "--duration-s", "12", "--out", dir_});
