@@ -59,8 +59,11 @@ TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) 
   DomainLease domain;
   char dir[] = "/tmp/beaconloc-bridge-XXXXXX";
   ASSERT_NE(::mkdtemp(dir), nullptr);
-  ChildProcess run({BEACONLOC_EXECUTABLE, "run", "--bridge", "--speed", "1", "--duration-s", "14", "--out",
-                    dir, "--domain", std::to_string(domain.id())},
+  // Until stopped (--duration-s 0): the test owns the run's lifetime and ends it when every step
+  // below is done; a fixed duration raced them (under load the run ended before the initial
+  // pose and the late readers).
+  ChildProcess run({BEACONLOC_EXECUTABLE, "run", "--bridge", "--speed", "1", "--duration-s", "0", "--out", dir,
+                    "--domain", std::to_string(domain.id())},
                    std::string(dir) + "/run.log");
 
   dds::DdsOptions options;
