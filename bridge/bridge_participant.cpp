@@ -122,6 +122,7 @@ void BridgeParticipant::on_pose(const msg::PoseEstimate& m) {
   if (m.robot_id() != options_.robot_id) return;
   const PoseEstimate e = dds::from_msg(m);
   std::lock_guard<std::mutex> lock(mutex_);
+  last_pose_received_ = std::chrono::steady_clock::now();
   if (!publishable(e)) {
     counts_.reject("pose.unusable");  // a non-finite number never reaches ROS 2
     return;
@@ -259,9 +260,20 @@ void BridgeParticipant::on_ros_initial_pose(const geometry_msgs::msg::PoseWithCo
 
 msg::Diagnostics BridgeParticipant::diagnostics_snapshot() {
   std::lock_guard<std::mutex> lock(mutex_);
-  return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts_, 0,
-                               msg::PARTICIPANT_STATUS_OK,
-                               std::string("ROS 2 ") + kRos2Distro + " layouts, robot " + options_.robot_id);
+  std::string message = std::string("ROS 2 ") + kRos2Distro + " layouts, robot " + options_.robot_id;
+  msg::ParticipantStatus status = msg::PARTICIPANT_STATUS_OK;
+  const auto now = std::chrono::steady_clock::now();
+  if (!last_pose_received_) {
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message += "; no pose received yet";
+  } else if (now - *last_pose_received_ > kPoseSilentAfter) {
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message +=
+        "; no pose for " +
+        std::to_string(std::chrono::duration_cast<std::chrono::seconds>(now - *last_pose_received_).count()) +
+        " s: the localizer is gone or silent";
+  }
+  return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts_, 0, status, message);
 }
 
 }  // namespace beaconloc::bridge

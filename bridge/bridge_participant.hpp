@@ -9,6 +9,7 @@
 #include <beaconloc.h>
 
 #include <atomic>
+#include <chrono>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -73,6 +74,10 @@ class BridgeParticipant {
   OdomFrame odom_;
   PendingTransforms pending_transforms_;  // poses newer than the odometry received so far
   RejectionCounter counts_;
+  // When the robot's last pose arrived: a bridge whose localizer stopped says so (a pose every
+  // 10 ms is the rate; kPoseSilentAfter is 200 of them).
+  static constexpr std::chrono::seconds kPoseSilentAfter{2};
+  std::optional<std::chrono::steady_clock::time_point> last_pose_received_;
   std::uint64_t odometry_sequence_ = 0;
   // Topic names live here: the TopicSpecs point into them.
   std::string beacon_pose_topic_, odometry_out_topic_, beacons_topic_, ranges_topic_, odom_in_topic_,

@@ -20,6 +20,10 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
   // A robot whose ranges miss their deadline (two beacon slots) coasts on odometry, degraded.
   dds::ReaderEvents<msg::BeaconRange> range_events;
   range_events.deadline_misses = &deadline_misses_;
+  // A decoder that dies or hangs (automatic liveliness, lease 1 s) is reported, not only felt as
+  // silent ranges.
+  range_events.writers_lost = &range_writers_lost_;
+  range_events.lost_and_none_alive = &range_writer_lost_;
   range_events.on_deadline_missed = [this](const msg::BeaconRange& key) {
     std::lock_guard<std::mutex> lock(mutex_);
     core_.on_ranges_silent(key.robot_id());
@@ -104,15 +108,22 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   } else if (odometry_writer_lost_.load()) {
     status = msg::PARTICIPANT_STATUS_DEGRADED;
     message = "no live odometry writer: the gateway was lost";
+  } else if (range_writer_lost_.load()) {
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message = "no live range writer: the decoder was lost";
   } else if (worst == PoseStatus::kDegraded || worst == PoseStatus::kLost) {
     status = msg::PARTICIPANT_STATUS_DEGRADED;
   }
   message += "; " + std::to_string(core_.replays()) + " late measurement(s) fused at their stamp";
+  if (core_.beacon_map_changes()) {
+    message += "; beacon map replaced " + std::to_string(core_.beacon_map_changes()) +
+               " time(s), every robot restarted on it";
+  }
   RejectionCounter counts = core_.counts();
   counts.reject("odometry.lost_increment", lost_increments_);
   auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, deadline_misses_.load(),
                                  status, message);
-  d.writers_lost(odometry_writers_lost_.load());
+  d.writers_lost(odometry_writers_lost_.load() + range_writers_lost_.load());
   return d;
 }
 

@@ -45,6 +45,8 @@ class LocalizerParticipant {
   static constexpr std::uint64_t kSequenceRestart = 1000;   // 10 s of odometry back: a new writer
   std::uint64_t lost_increments_ = 0;                       // sequence numbers never received
   std::atomic<bool> odometry_writer_lost_{false};           // lost, none alive since
+  std::atomic<std::uint64_t> range_writers_lost_{0};        // the decoder's beacon_range writer
+  std::atomic<bool> range_writer_lost_{false};              // lost, none alive since
   std::atomic<std::uint64_t> odometry_processed_{0};
   std::atomic<std::uint64_t> ranges_processed_{0};
   std::atomic<std::uint64_t> poses_written_{0};

@@ -1,0 +1,163 @@
+// The beacon map on the bus as a user changes it (issue 23, item 1): a gateway replaced by one
+// whose scenario has fewer beacons, two gateways with different maps at once, and maps that no
+// site has (a repeated id, a NaN position). The localizer crashed on the first two; every one
+// must leave it running, say what happened, and localize on the map it keeps.
+#include <beaconlocPubSubTypes.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <thread>
+
+#include "beaconloc/dds/convert.hpp"
+#include "diagnostics_recorder.hpp"
+#include "participants_test.hpp"
+#include "pose_recorder.hpp"
+#include "process.hpp"
+#include "sim/scenario.hpp"
+
+namespace beaconloc::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+const std::string kSource = BEACONLOC_SOURCE_DIR;
+
+class BeaconMapOnTheBus : public ParticipantsTest {
+ protected:
+  // The default scenario with some beacon lines taken out or changed: `edit` maps each line.
+  std::string scenario_file(const std::string& name,
+                            const std::function<std::string(const std::string&)>& edit) {
+    std::ifstream in(kSource + "/examples/scenarios/default.yaml");
+    std::ofstream out(path(name));
+    for (std::string line; std::getline(in, line);) out << edit(line) << '\n';
+    return path(name);
+  }
+  // Waits until the participant's Diagnostics satisfy `ready`; the last ones seen.
+  static msg::Diagnostics wait_for(const DiagnosticsRecorder& recorder, const std::string& name,
+                                   const std::function<bool(const msg::Diagnostics&)>& ready) {
+    const auto end = std::chrono::steady_clock::now() + scaled(20s);
+    msg::Diagnostics d;
+    while (std::chrono::steady_clock::now() < end) {
+      const auto latest = recorder.latest();
+      if (latest.count(name)) {
+        d = latest.at(name);
+        if (ready(d)) break;
+      }
+      std::this_thread::sleep_for(100ms);
+    }
+    return d;
+  }
+  static bool eventually(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+    const auto end = std::chrono::steady_clock::now() + scaled(timeout);
+    while (!done()) {
+      if (std::chrono::steady_clock::now() > end) return false;
+      std::this_thread::sleep_for(50ms);
+    }
+    return true;
+  }
+};
+
+const char* kLocalizer = "beaconloc.localizer.range_ekf";
+
+// The user's sequence: stop the gateway, start one on a scenario without beacons 4-6 (the three
+// left are on one line), and later one with every beacon again. The localizer restarts the
+// robot on each new map, says so, and keeps publishing; it crashed within 3 s before.
+TEST_F(BeaconMapOnTheBus, AGatewayWithFewerBeaconsReplacesTheMapAndTheLocalizerGoesOn) {
+  DiagnosticsRecorder diagnostics(dds_);
+  PoseRecorder poses(dds_);
+  ChildProcess localizer(command("localizer"), path("localizer.log"));
+  ChildProcess decoder(command("decoder"), path("decoder.log"));
+  auto gateway = std::make_unique<ChildProcess>(command("gateway", {"--seed", "3"}), path("gateway1.log"));
+  ASSERT_TRUE(eventually([&] { return poses.count() > 100; }, 20s)) << localizer.log();
+  gateway->signal(SIGTERM);
+  ASSERT_TRUE(gateway->wait(15s));
+
+  const std::string fewer = scenario_file("fewer.yaml", [](const std::string& line) {
+    for (const char* id : {"{id: 4,", "{id: 5,", "{id: 6,"}) {
+      if (line.find(id) != std::string::npos) return std::string();
+    }
+    // The firing order may name only beacons that are there.
+    if (line.find("firing_order:") != std::string::npos) return std::string("  firing_order: [1, 2, 3]");
+    return line;
+  });
+  gateway = std::make_unique<ChildProcess>(command("gateway", {"--scenario", fewer, "--seed", "4"}),
+                                           path("gateway2.log"));
+  const auto replaced = wait_for(diagnostics, kLocalizer, [](const msg::Diagnostics& d) {
+    return d.message().find("beacon map replaced 1 time(s)") != std::string::npos;
+  });
+  EXPECT_NE(replaced.message().find("beacon map replaced 1 time(s)"), std::string::npos)
+      << replaced.message();
+  // 3 s of the new gateway's odometry through a localizer that is still there.
+  const std::size_t at_change = poses.count();
+  std::this_thread::sleep_for(scaled(3s));
+  EXPECT_FALSE(localizer.wait(0ms)) << "the localizer exited:\n" << localizer.log();
+  gateway->signal(SIGTERM);
+  ASSERT_TRUE(gateway->wait(15s));
+
+  // Every beacon again, two gateways at once (one moved by 0.5 m): two maps on the bus.
+  const std::string moved = scenario_file("moved.yaml", [](const std::string& line) {
+    const std::string from = "{id: 1, position_m: [0.0,";
+    return line.find(from) == std::string::npos ? line : "  - {id: 1, position_m: [0.5, -0.3, 2.011]}";
+  });
+  ChildProcess a(command("gateway", {"--seed", "5", "--robot", "robot1"}), path("gateway3.log"));
+  ChildProcess b(command("gateway", {"--scenario", moved, "--seed", "6", "--robot", "robot2"}),
+                 path("gateway4.log"));
+  ASSERT_TRUE(eventually([&] { return poses.count() > at_change + 200; }, 20s)) << localizer.log();
+  std::this_thread::sleep_for(scaled(3s));
+  EXPECT_FALSE(localizer.wait(0ms)) << "the localizer exited:\n" << localizer.log();
+  for (ChildProcess* g : {&a, &b}) {
+    g->signal(SIGTERM);
+    EXPECT_TRUE(g->wait(15s));
+  }
+  stop_cleanly(localizer, "localizer");
+  stop_cleanly(decoder, "decoder");
+  for (const auto& p : poses.poses()) ASSERT_TRUE(publishable(p.row.estimate));
+}
+
+// Maps no site has, written to the bus by a faulty gateway: each refused whole by reason in the
+// localizer's and the decoder's Diagnostics; the good map they had stays in use.
+TEST_F(BeaconMapOnTheBus, MalformedMapsAreRefusedByReasonAndTheGoodOneKept) {
+  DiagnosticsRecorder diagnostics(dds_);
+  ChildProcess localizer(command("localizer"), path("localizer.log"));
+  ChildProcess decoder(command("decoder"), path("decoder.log"));
+  dds::Participant bus(dds_, "test.faulty_gateway");
+  auto* map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
+  ASSERT_TRUE(eventually(
+      [&] {
+        eprosima::fastdds::dds::PublicationMatchedStatus status;
+        map_writer->get_publication_matched_status(status);
+        return status.current_count >= 2;
+      },
+      10s));
+  msg::BeaconMap good = dds::to_msg(BeaconMap(sim::default_scenario().beacons), "map");
+  map_writer->write(&good);
+  std::vector<std::pair<msg::BeaconMap, const char*>> bad;
+  bad.push_back({good, "beacon_map.duplicate_id"});
+  bad.back().first.beacons().push_back(good.beacons()[1]);
+  bad.push_back({good, "beacon_map.non_finite_position"});
+  bad.back().first.beacons()[2].z_m(std::numeric_limits<double>::quiet_NaN());
+  bad.push_back({good, "beacon_map.position_out_of_range"});
+  bad.back().first.beacons()[0].x_m(1e300);
+  bad.push_back({good, "beacon_map.empty"});
+  bad.back().first.beacons().clear();
+  // One at a time: the topic keeps the newest map only (keep_last 1), as a late joiner needs.
+  for (auto& [map, reason] : bad) {
+    map_writer->write(&map);
+    for (const char* name : {kLocalizer, "beaconloc.decoder"}) {
+      const auto d = wait_for(diagnostics, name, [reason = reason](const msg::Diagnostics& x) {
+        return rejected_count(x, reason) > 0;
+      });
+      EXPECT_EQ(rejected_count(d, reason), 1u) << name;
+      EXPECT_EQ(d.message().find("waiting for the beacon map"), std::string::npos)
+          << name << ": " << d.message();
+    }
+  }
+  stop_cleanly(localizer, "localizer");
+  stop_cleanly(decoder, "decoder");
+}
+
+}  // namespace
+}  // namespace beaconloc::testing
