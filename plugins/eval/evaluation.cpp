@@ -75,6 +75,10 @@ Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estima
   bool all_have_yaw = true;
   std::vector<std::pair<const EstimateRow*, TruthSample>> scored;
   for (const auto& row : estimates) {
+    if (!publishable(row.estimate)) {  // refused where it was read; one here is a bug upstream
+      throw std::invalid_argument("evaluate: an estimate at stamp " + std::to_string(row.estimate.stamp_ns) +
+                                  " is not finite");
+    }
     if (row.estimate.stamp_ns < options.score_from_ns) continue;
     const auto t = truth.at(row.estimate.stamp_ns, options.max_truth_gap_ns);
     if (!t) {
@@ -177,6 +181,15 @@ std::vector<EstimateRow> load_estimates_csv(const std::string& path) {
 }
 
 void write_estimates_csv(const std::string& path, const std::vector<EstimateRow>& rows) {
+  // Every reader of poses refuses a non-finite one at its door (localizer, bridge, recorder): one
+  // here is a bug upstream, and no file gets it.
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (!publishable(rows[i].estimate)) {
+      throw std::invalid_argument("'" + path + "': estimate " + std::to_string(i) + " (stamp " +
+                                  std::to_string(rows[i].estimate.stamp_ns) +
+                                  ") is not finite; nothing written");
+    }
+  }
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write '" + path + "'");
   for (std::size_t i = 0; i < kEstimateColumns.size(); ++i) out << (i ? "," : "") << kEstimateColumns[i];
@@ -193,6 +206,15 @@ void write_estimates_csv(const std::string& path, const std::vector<EstimateRow>
 
 void write_metrics_json(const std::string& path, const Metrics& m, const std::string& estimator,
                         const std::string& source) {
+  // A figure is written only where something was scored: with no sample, every figure is null
+  // (a run that scored nothing has no error of 0 m). A figure that is not finite is never
+  // written: the evaluation refuses it, and the file is not left half-written.
+  const bool scored = m.samples > 0;
+  auto figure = [&](double v) { return scored ? std::optional<double>(v) : std::nullopt; };
+  for (const auto& v : {figure(m.position_rms_m), figure(m.position_mean_m), figure(m.position_max_m),
+                        m.heading_rms_deg, m.significant_points_mean_m, figure(m.nees_in_band_fraction)}) {
+    if (v && !std::isfinite(*v)) throw std::runtime_error("'" + path + "': a metric is not finite");
+  }
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write '" + path + "'");
   auto quoted = [](const std::string& s) {
@@ -212,15 +234,6 @@ void write_metrics_json(const std::string& path, const Metrics& m, const std::st
       s << "null";
     return s.str();
   };
-  // A figure is written only where something was scored: with no sample, every figure is null
-  // (a run that scored nothing has no error of 0 m). A figure that is not finite is never
-  // written: the evaluation refuses it, and the file is not left half-written.
-  const bool scored = m.samples > 0;
-  auto figure = [&](double v) { return scored ? std::optional<double>(v) : std::nullopt; };
-  for (const auto& v : {figure(m.position_rms_m), figure(m.position_mean_m), figure(m.position_max_m),
-                        m.heading_rms_deg, m.significant_points_mean_m, figure(m.nees_in_band_fraction)}) {
-    if (v && !std::isfinite(*v)) throw std::runtime_error("'" + path + "': a metric is not finite");
-  }
   out << std::setprecision(6) << "{\n"
       << "  \"estimator\": " << quoted(estimator) << ",\n"
       << "  \"source\": " << quoted(source) << ",\n"
