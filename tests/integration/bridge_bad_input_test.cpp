@@ -1,0 +1,148 @@
+// The bridge is an output path to ROS 2: a pose, a range or a beacon map with a non-finite
+// number, from a faulty participant on the bus, never reaches a ROS 2 topic; each is counted by
+// reason in the bridge's Diagnostics, and the good samples around them go through (issue 23).
+#include <beaconlocPubSubTypes.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <thread>
+
+#include "beaconloc/dds/convert.hpp"
+#include "diagnostics_recorder.hpp"
+#include "participants_test.hpp"
+#include "process.hpp"
+#include "ros2_types.hpp"
+#include "sim/scenario.hpp"
+
+namespace beaconloc::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+class BridgeBadInput : public ParticipantsTest {};
+
+template <class Pred>
+bool eventually(Pred pred, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + scaled(timeout);
+  while (!pred()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(20ms);
+  }
+  return true;
+}
+
+TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
+  DiagnosticsRecorder diagnostics(dds_);
+  ChildProcess bridge(command("bridge"), path("bridge.log"));
+  dds::DdsOptions options = dds_;
+  options.extra_qos_files = {std::string(BEACONLOC_SOURCE_DIR) + "/tests/integration/rviz2_readers.xml"};
+  dds::Participant bus(options, "test.faulty_localizer");
+  auto* pose_writer = bus.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic);
+  auto* range_writer = bus.writer<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic);
+  auto* map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
+  std::mutex mutex;
+  std::vector<geometry_msgs::msg::PoseWithCovarianceStamped> poses;
+  std::vector<sensor_msgs::msg::Range> ranges;
+  std::size_t marker_arrays = 0;
+  bus.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+      {"rt/beacon_pose", "", "rviz2.reader"}, [&](const auto& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        poses.push_back(m);
+      });
+  bus.subscribe<sensor_msgs::msg::RangePubSubType>({"rt/beacon_ranges", "", "rviz2.reader"},
+                                                   [&](const auto& m) {
+                                                     std::lock_guard<std::mutex> lock(mutex);
+                                                     ranges.push_back(m);
+                                                   });
+  bus.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>({"rt/beacons", "", "rviz2.reader"},
+                                                                [&](const auto&) {
+                                                                  std::lock_guard<std::mutex> lock(mutex);
+                                                                  ++marker_arrays;
+                                                                });
+  ASSERT_TRUE(dds::wait_for_matched_readers({pose_writer, range_writer, map_writer}, scaled(10s)))
+      << bridge.log();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+
+  // Poses: good, NaN x, infinite covariance, good.
+  auto pose = [&](StampNs stamp_ns, double x, double var_x) {
+    PoseEstimate e;
+    e.stamp_ns = stamp_ns;
+    e.pose_map_base = {x, 1.0, 0.2};
+    e.covariance = 1e-4 * Cov3::Identity();
+    e.covariance(0, 0) = var_x;
+    e.status = PoseStatus::kOk;
+    return dds::to_msg("robot1", e, "range_ekf", {});
+  };
+  for (auto m : {pose(kNsPerSecond, 1.0, 1e-4), pose(2 * kNsPerSecond, nan, 1e-4),
+                 pose(3 * kNsPerSecond, 1.5, std::numeric_limits<double>::infinity()),
+                 pose(4 * kNsPerSecond, 2.0, 1e-4)}) {
+    pose_writer->write(&m);
+  }
+  // Ranges: good, NaN, good.
+  auto range = [&](double range_m) {
+    msg::BeaconRange m;
+    m.robot_id("robot1");
+    m.stamp_ns(kNsPerSecond);
+    m.beacon_id(1);
+    m.receiver_id(0);
+    m.range_m(range_m);
+    m.variance_m2(1e-4);
+    m.association(msg::RANGE_ASSOCIATION_BY_ID);
+    return m;
+  };
+  for (auto m : {range(2.0), range(nan), range(2.5)}) range_writer->write(&m);
+  // A beacon map with a NaN: no markers; then a good one: markers.
+  msg::BeaconMap map = dds::to_msg(BeaconMap(sim::default_scenario().beacons), "map");
+  msg::BeaconMap bad_map = map;
+  bad_map.beacons()[0].x_m(nan);
+  map_writer->write(&bad_map);
+  std::this_thread::sleep_for(scaled(300ms));  // the topic keeps only the newest map
+  map_writer->write(&map);
+
+  ASSERT_TRUE(eventually(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return poses.size() >= 2 && ranges.size() >= 2 && marker_arrays >= 1;
+      },
+      10s))
+      << bridge.log();
+  std::this_thread::sleep_for(scaled(500ms));  // anything else that was to come
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    EXPECT_EQ(poses.size(), 2u);
+    for (const auto& p : poses) {
+      EXPECT_TRUE(std::isfinite(p.pose().pose().position().x()));
+      for (double c : p.pose().covariance()) EXPECT_TRUE(std::isfinite(c));
+    }
+    EXPECT_EQ(ranges.size(), 2u);
+    for (const auto& r : ranges) EXPECT_TRUE(std::isfinite(r.range()));
+    EXPECT_EQ(marker_arrays, 1u);
+  }
+  const auto latest = [&] {
+    msg::Diagnostics d;
+    eventually(
+        [&] {
+          const auto all = diagnostics.latest();
+          for (const auto& [name, x] : all) {
+            if (name.rfind("beaconloc.bridge", 0) == 0 &&
+                rejected_count(x, "beacon_map.non_finite_position")) {
+              d = x;
+              return true;
+            }
+          }
+          return false;
+        },
+        10s);
+    return d;
+  }();
+  EXPECT_EQ(rejected_count(latest, "pose.unusable"), 2u);
+  EXPECT_EQ(rejected_count(latest, "range.unusable"), 1u);
+  EXPECT_EQ(rejected_count(latest, "beacon_map.non_finite_position"), 1u);
+  stop_cleanly(bridge, "bridge");
+}
+
+}  // namespace
+}  // namespace beaconloc::testing
