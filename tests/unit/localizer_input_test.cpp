@@ -301,3 +301,20 @@ TEST(NonFiniteEstimate, PublishableHoldsEveryNumber) {
 
 }  // namespace
 }  // namespace beaconloc
+
+namespace beaconloc {
+namespace {
+
+// An initial pose (rviz2's 2D Pose Estimate, the bus) where no beacon can be is refused.
+TEST(InitialPose, FarBeyondAnySiteIsRefusedByReason) {
+  Robot robot;
+  robot.feed(0.0, 5.0);
+  robot.core.on_initial_pose("r", s_to_ns(5.0), Pose2(1e300, 0.0, 0.0), 0.01 * Cov3::Identity());
+  robot.core.on_initial_pose("r", s_to_ns(5.0), Pose2(1.0, 0.0, 0.0), 1e300 * Cov3::Identity());
+  EXPECT_EQ(robot.core.counts().rejected("initial_pose.implausible_initial_pose"), 2u);
+  const Robot::Pass after = robot.feed(5.0, 10.0);
+  EXPECT_LT(after.worst_ok_error_m, 0.1);
+}
+
+}  // namespace
+}  // namespace beaconloc

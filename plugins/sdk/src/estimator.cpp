@@ -100,6 +100,12 @@ InputResult check_initial_pose(const Pose2& pose, const Cov3& c) {
       Eigen::LLT<Cov3>(c).info() != Eigen::Success) {
     return InputResult::rejected("invalid_initial_pose");
   }
+  // Where no beacon can be (core/beacon_map.hpp's bound), or a standard deviation beyond it:
+  // no place to start from.
+  if (pose.head<2>().cwiseAbs().maxCoeff() > kMaxBeaconCoordinateM ||
+      c.diagonal().maxCoeff() > kMaxBeaconCoordinateM * kMaxBeaconCoordinateM) {
+    return InputResult::rejected("implausible_initial_pose");
+  }
   return InputResult::ok();
 }
 
