@@ -17,6 +17,7 @@
 #include "pose_recorder.hpp"
 #include "process.hpp"
 #include "sim/scenario.hpp"
+#include "waits.hpp"
 
 namespace beaconloc::testing {
 namespace {
@@ -34,29 +35,6 @@ class BeaconMapOnTheBus : public ParticipantsTest {
     std::ofstream out(path(name));
     for (std::string line; std::getline(in, line);) out << edit(line) << '\n';
     return path(name);
-  }
-  // Waits until the participant's Diagnostics satisfy `ready`; the last ones seen.
-  static msg::Diagnostics wait_for(const DiagnosticsRecorder& recorder, const std::string& name,
-                                   const std::function<bool(const msg::Diagnostics&)>& ready) {
-    const auto end = std::chrono::steady_clock::now() + scaled(20s);
-    msg::Diagnostics d;
-    while (std::chrono::steady_clock::now() < end) {
-      const auto latest = recorder.latest();
-      if (latest.count(name)) {
-        d = latest.at(name);
-        if (ready(d)) break;
-      }
-      std::this_thread::sleep_for(100ms);
-    }
-    return d;
-  }
-  static bool eventually(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
-    const auto end = std::chrono::steady_clock::now() + scaled(timeout);
-    while (!done()) {
-      if (std::chrono::steady_clock::now() > end) return false;
-      std::this_thread::sleep_for(50ms);
-    }
-    return true;
   }
 };
 
@@ -85,7 +63,7 @@ TEST_F(BeaconMapOnTheBus, AGatewayWithFewerBeaconsReplacesTheMapAndTheLocalizerG
   });
   gateway = std::make_unique<ChildProcess>(command("gateway", {"--scenario", fewer, "--seed", "4"}),
                                            path("gateway2.log"));
-  const auto replaced = wait_for(diagnostics, kLocalizer, [](const msg::Diagnostics& d) {
+  const auto replaced = wait_for_diagnostics(diagnostics, kLocalizer, [](const msg::Diagnostics& d) {
     return d.message().find("beacon map replaced 1 time(s)") != std::string::npos;
   });
   EXPECT_NE(replaced.message().find("beacon map replaced 1 time(s)"), std::string::npos)
@@ -147,7 +125,7 @@ TEST_F(BeaconMapOnTheBus, MalformedMapsAreRefusedByReasonAndTheGoodOneKept) {
   for (auto& [map, reason] : bad) {
     map_writer->write(&map);
     for (const char* name : {kLocalizer, "beaconloc.decoder"}) {
-      const auto d = wait_for(diagnostics, name, [reason = reason](const msg::Diagnostics& x) {
+      const auto d = wait_for_diagnostics(diagnostics, name, [reason = reason](const msg::Diagnostics& x) {
         return rejected_count(x, reason) > 0;
       });
       EXPECT_EQ(rejected_count(d, reason), 1u) << name;

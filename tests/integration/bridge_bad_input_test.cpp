@@ -16,6 +16,7 @@
 #include "process.hpp"
 #include "ros2_types.hpp"
 #include "sim/scenario.hpp"
+#include "waits.hpp"
 
 namespace beaconloc::testing {
 namespace {
@@ -23,16 +24,6 @@ namespace {
 using namespace std::chrono_literals;
 
 class BridgeBadInput : public ParticipantsTest {};
-
-template <class Pred>
-bool eventually(Pred pred, std::chrono::milliseconds timeout) {
-  const auto end = std::chrono::steady_clock::now() + scaled(timeout);
-  while (!pred()) {
-    if (std::chrono::steady_clock::now() > end) return false;
-    std::this_thread::sleep_for(20ms);
-  }
-  return true;
-}
 
 TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
   DiagnosticsRecorder diagnostics(dds_);
@@ -121,23 +112,9 @@ TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
     for (const auto& r : ranges) EXPECT_TRUE(std::isfinite(r.range()));
     EXPECT_EQ(marker_arrays, 1u);
   }
-  const auto latest = [&] {
-    msg::Diagnostics d;
-    eventually(
-        [&] {
-          const auto all = diagnostics.latest();
-          for (const auto& [name, x] : all) {
-            if (name.rfind("beaconloc.bridge", 0) == 0 &&
-                rejected_count(x, "beacon_map.non_finite_position")) {
-              d = x;
-              return true;
-            }
-          }
-          return false;
-        },
-        10s);
-    return d;
-  }();
+  const auto latest = wait_for_diagnostics(diagnostics, "beaconloc.bridge", [](const msg::Diagnostics& d) {
+    return rejected_count(d, "beacon_map.non_finite_position") > 0;
+  });
   EXPECT_EQ(rejected_count(latest, "pose.unusable"), 2u);
   EXPECT_EQ(rejected_count(latest, "range.unusable"), 1u);
   EXPECT_EQ(rejected_count(latest, "beacon_map.non_finite_position"), 1u);

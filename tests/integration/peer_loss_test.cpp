@@ -8,6 +8,7 @@
 #include "diagnostics_recorder.hpp"
 #include "participants_test.hpp"
 #include "process.hpp"
+#include "waits.hpp"
 
 namespace beaconloc::testing {
 namespace {
@@ -16,21 +17,6 @@ using namespace std::chrono_literals;
 
 class PeerLoss : public ParticipantsTest {
  protected:
-  // The newest Diagnostics of the participant whose name starts with `prefix`, once `ready`.
-  static msg::Diagnostics wait_for(const DiagnosticsRecorder& recorder, const std::string& prefix,
-                                   const std::function<bool(const msg::Diagnostics&)>& ready) {
-    const auto end = std::chrono::steady_clock::now() + scaled(20s);
-    msg::Diagnostics d;
-    while (std::chrono::steady_clock::now() < end) {
-      for (const auto& [name, x] : recorder.latest()) {
-        if (name.rfind(prefix, 0) != 0) continue;
-        d = x;
-        if (ready(d)) return d;
-      }
-      std::this_thread::sleep_for(100ms);
-    }
-    return d;
-  }
   static bool says(const msg::Diagnostics& d, const std::string& text) {
     return d.message().find(text) != std::string::npos;
   }
@@ -42,21 +28,21 @@ TEST_F(PeerLoss, TheLocalizerSaysItsDecoderDiedAndTheBridgeItsLocalizer) {
   auto decoder = std::make_unique<ChildProcess>(command("decoder"), path("decoder.log"));
   auto localizer = std::make_unique<ChildProcess>(command("localizer"), path("localizer.log"));
   ChildProcess bridge(command("bridge"), path("bridge.log"));
-  const auto live = wait_for(diagnostics, "beaconloc.bridge", [](const msg::Diagnostics& d) {
+  const auto live = wait_for_diagnostics(diagnostics, "beaconloc.bridge", [](const msg::Diagnostics& d) {
     return d.status() == msg::PARTICIPANT_STATUS_OK;
   });
   ASSERT_EQ(live.status(), msg::PARTICIPANT_STATUS_OK) << live.message() << "\n" << localizer->log();
 
   decoder->signal(SIGKILL);  // dies without leaving: only its lapsed liveliness tells
   decoder->wait(10s);
-  const auto orphaned = wait_for(diagnostics, "beaconloc.localizer", [](const msg::Diagnostics& d) {
-    return says(d, "no live range writer: the decoder was lost");
-  });
+  const auto orphaned = wait_for_diagnostics(
+      diagnostics, "beaconloc.localizer",
+      [](const msg::Diagnostics& d) { return says(d, "no live range writer: the decoder was lost"); });
   EXPECT_TRUE(says(orphaned, "no live range writer: the decoder was lost")) << orphaned.message();
   EXPECT_EQ(orphaned.status(), msg::PARTICIPANT_STATUS_DEGRADED);
 
   stop_cleanly(*localizer, "localizer");
-  const auto silent = wait_for(diagnostics, "beaconloc.bridge", [](const msg::Diagnostics& d) {
+  const auto silent = wait_for_diagnostics(diagnostics, "beaconloc.bridge", [](const msg::Diagnostics& d) {
     return says(d, "the localizer is gone or silent");
   });
   EXPECT_TRUE(says(silent, "the localizer is gone or silent")) << silent.message();
