@@ -112,6 +112,13 @@ TEST_F(BeaconMapOnTheBus, MalformedMapsAreRefusedByReasonAndTheGoodOneKept) {
       10s));
   msg::BeaconMap good = dds::to_msg(BeaconMap(sim::default_scenario().beacons), "map");
   map_writer->write(&good);
+  for (const char* name : {kLocalizer, "beaconloc.decoder"}) {  // taken before the next replaces it
+    const auto d = wait_for_diagnostics(diagnostics, name, [](const msg::Diagnostics& x) {
+      return x.message().find("waiting for the beacon map") == std::string::npos;
+    });
+    ASSERT_EQ(d.message().find("waiting for the beacon map"), std::string::npos)
+        << name << ": " << d.message();
+  }
   std::vector<std::pair<msg::BeaconMap, const char*>> bad;
   bad.push_back({good, "beacon_map.duplicate_id"});
   bad.back().first.beacons().push_back(good.beacons()[1]);

@@ -90,7 +90,11 @@ TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
   msg::BeaconMap bad_map = map;
   bad_map.beacons()[0].x_m(nan);
   map_writer->write(&bad_map);
-  std::this_thread::sleep_for(scaled(300ms));  // the topic keeps only the newest map
+  // The topic keeps only the newest map: the good one goes once the bad one was refused.
+  const auto refused = wait_for_diagnostics(diagnostics, "beaconloc.bridge", [](const msg::Diagnostics& d) {
+    return rejected_count(d, "beacon_map.non_finite_position") > 0;
+  });
+  EXPECT_EQ(rejected_count(refused, "beacon_map.non_finite_position"), 1u) << refused.message();
   map_writer->write(&map);
 
   ASSERT_TRUE(eventually(
