@@ -1,7 +1,8 @@
 // `beaconloc monitor` and the liveness of participants, with the participants as processes on
-// loopback: a participant that stops or is killed shows as gone or silent, never ok; the monitor
-// keeps O(robots) of the pose stream unless it scores or writes, writes every pose when asked
-// to, and prints or writes no non-finite number. A test kills a process: the
+// loopback: a participant that stops or is killed shows as gone or silent, never ok; two
+// localizers serving one robot both report the conflict (and so does the monitor) until one
+// stops; the monitor keeps O(robots) of the pose stream unless it scores or writes, writes every
+// pose when asked to, and prints or writes no non-finite number. A test kills a process: the
 // UDP-only loopback profile (a killed process cannot remove shared-memory segments).
 #include <beaconlocPubSubTypes.h>
 #include <gtest/gtest.h>
@@ -132,6 +133,117 @@ TEST_F(Monitor, AParticipantThatStopsOrIsKilledShowsGoneOrSilentNeverOk) {
   EXPECT_EQ(out.find("beaconloc.gateway.g1: ok", after_kill), std::string::npos) << out;
   EXPECT_TRUE(has_line_starting(out, "monitor: no pose received (")) << out;  // each second
   EXPECT_EQ(lines_of(out).back(), "monitor: no pose received") << out;
+}
+
+// Item 11 of issue 23: two localizers serving one robot went unnoticed. Each lists the robots it
+// serves in its Diagnostics and reads the others': both report the conflict (degraded, counted,
+// naming the robot and the other localizer) and publish that robot's poses degraded while it
+// lasts; the monitor sees two writers of one robot. When one stops, the other clears.
+TEST_F(Monitor, TwoLocalizersServingOneRobotBothReportTheConflictUntilOneStops) {
+  const std::string ekf = "beaconloc.localizer.range_ekf", duhl = "beaconloc.localizer.duhl";
+  DiagnosticsRecorder diagnostics(dds_);
+  PoseRecorder poses(dds_);
+  ChildProcess monitor(command("monitor"), path("monitor.log"));
+  ChildProcess ekf_localizer(command("localizer", {"--estimator", "range_ekf"}), path("range_ekf.log"));
+  ChildProcess duhl_localizer(command("localizer", {"--estimator", "duhl"}), path("duhl.log"));
+  ChildProcess decoder(command("decoder"), path("decoder.log"));
+  ChildProcess gateway(command("gateway", {"--robot", "robot1", "--duration-s", "120", "--seed", "3"}),
+                       path("gateway.log"));
+
+  auto in_conflict = [](const std::map<std::string, msg::Diagnostics>& latest, const std::string& name,
+                        const std::string& other) {
+    if (!latest.count(name)) return false;
+    const auto& d = latest.at(name);
+    return d.status() == msg::PARTICIPANT_STATUS_DEGRADED && d.serving_conflicts() >= 1 &&
+           d.message().find("robot robot1 also served by " + other) != std::string::npos;
+  };
+  std::map<std::string, msg::Diagnostics> latest;
+  ASSERT_TRUE(wait_until(
+      [&] {
+        latest = diagnostics.latest();
+        return in_conflict(latest, ekf, duhl) && in_conflict(latest, duhl, ekf);
+      },
+      30s))
+      << ekf_localizer.log() << duhl_localizer.log();
+  std::printf("%s: %s\n%s: %s\n", ekf.c_str(), latest.at(ekf).message().c_str(), duhl.c_str(),
+              latest.at(duhl).message().c_str());
+  // Each lists the robot it serves.
+  ASSERT_EQ(latest.at(ekf).robots_localized().size(), 1u);
+  EXPECT_EQ(latest.at(ekf).robots_localized()[0], "robot1");
+  // A pose either writes for an odometry sample stamped after its conflicting report (the
+  // gateway stamps with the wall clock) was estimated after it found the conflict: never ok.
+  const std::map<std::string, StampNs> conflict_from{{"range_ekf", latest.at(ekf).stamp_ns()},
+                                                     {"duhl", latest.at(duhl).stamp_ns()}};
+  std::map<std::string, std::size_t> during, ok_during;
+  ASSERT_TRUE(wait_until(
+      [&] {
+        during.clear();
+        ok_during.clear();
+        for (const auto& p : poses.poses()) {
+          const auto from = conflict_from.find(p.row.estimator);
+          if (from == conflict_from.end() || p.row.estimate.stamp_ns <= from->second) continue;
+          ++during[p.row.estimator];
+          if (p.row.estimate.status == PoseStatus::kOk) ++ok_during[p.row.estimator];
+        }
+        return during["range_ekf"] >= 100 && during["duhl"] >= 100;
+      },
+      30s));
+  EXPECT_EQ(ok_during["range_ekf"], 0u);
+  EXPECT_EQ(ok_during["duhl"], 0u);
+  ASSERT_TRUE(wait_for_line(monitor, "robot1 ", 10s));
+  ASSERT_TRUE(wait_until(
+      [&] { return monitor.log().find("CONFLICT: poses from 2 localizers at once") != std::string::npos; },
+      10s))
+      << monitor.log();
+
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(duhl_localizer, "duhl localizer"));
+  ASSERT_TRUE(wait_until(
+      [&] {
+        latest = diagnostics.latest();
+        return latest.at(ekf).message().find("serving conflict") == std::string::npos;
+      },
+      10s))
+      << latest.at(ekf).message();
+  EXPECT_GE(latest.at(ekf).serving_conflicts(), 1u);  // the count stays
+  const StampNs cleared_at = latest.at(ekf).stamp_ns();
+  ASSERT_TRUE(wait_until(
+      [&] {
+        const auto newest = poses.newest();
+        return newest && newest->row.estimator == "range_ekf" && newest->row.estimate.stamp_ns > cleared_at &&
+               newest->row.estimate.status == PoseStatus::kOk;
+      },
+      20s))
+      << ekf_localizer.log();
+
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(gateway, "gateway"));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(ekf_localizer, "range_ekf localizer"));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(monitor, "monitor"));
+  const std::string conflict =
+      last_line_starting(monitor.log(), "conflict: robot1 got poses from 2 localizers at once:");
+  EXPECT_NE(conflict.find("range_ekf ("), std::string::npos) << monitor.log();
+  EXPECT_NE(conflict.find("duhl ("), std::string::npos) << monitor.log();
+}
+
+// A peer's report listing more robots than the wire contract's bound (DIAGNOSTICS_MAX_ROBOTS) is
+// refused and counted by a localizer, not taken in part.
+TEST_F(Monitor, ALocalizerRefusesAPeerReportListingMoreRobotsThanTheBound) {
+  const std::string name = "beaconloc.localizer.range_ekf";
+  DiagnosticsRecorder diagnostics(dds_);
+  ChildProcess localizer(command("localizer"), path("localizer.log"));
+  dds::Participant bus(dds_, "test.fake_localizer");
+  auto* writer = bus.writer<msg::DiagnosticsPubSubType>(dds::kDiagnosticsTopic);
+  ASSERT_TRUE(wait_until([&] { return diagnostics.latest().count(name) == 1; }, 15s)) << localizer.log();
+  msg::Diagnostics d;
+  d.participant("test.fake_localizer");
+  for (std::uint32_t i = 0; i <= msg::DIAGNOSTICS_MAX_ROBOTS; ++i)
+    d.robots_localized().push_back("r" + std::to_string(i));
+  ASSERT_TRUE(writer->write(&d));
+  ASSERT_TRUE(wait_until(
+      [&] { return rejected_count(diagnostics.latest().at(name), "diagnostics.too_many_robots") == 1; }, 15s))
+      << localizer.log();
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
+  bus.close();
 }
 
 // Item 12 of issue 23: the monitor kept (and copied each second) every pose. Without --truth or
