@@ -13,11 +13,10 @@
 #include "beaconloc/dds/stop_signal.hpp"
 #include "bridge_participant.hpp"
 #include "decoder_participant.hpp"
-#include "diagnostics_recorder.hpp"
 #include "localizer_participant.hpp"
+#include "monitor.hpp"
 #include "offline_run.hpp"
 #include "pipeline.hpp"
-#include "pose_recorder.hpp"
 #include "sim/faults.hpp"
 #include "sim/scenario_yaml.hpp"
 
@@ -265,12 +264,15 @@ int run(int argc, char** argv) {
       ->check(kNonNegative);
 
   auto* monitor = app.add_subcommand(
-      "monitor", "print the poses on the bus each second; with --truth, the accuracy at the end");
+      "monitor",
+      "print each robot's newest pose every second and each participant's health as it changes (gone or "
+      "silent when it stopped or died); at the end, every participant's counts and the robots served by "
+      "two localizers; with --truth, the accuracy");
   add_dds_options(monitor, dds_options);
   monitor->add_option("--duration-s", monitor_duration_s, "stop after this many seconds (0: until stopped)")
       ->check(kNonNegative);
   monitor->add_option("--truth", truth_file, "ground truth CSV written by the gateway");
-  monitor->add_option("--out", estimate_file, "write the poses to this CSV");
+  monitor->add_option("--out", estimate_file, "write every pose to this CSV at the end");
 
   CLI11_PARSE(app, argc, argv);
   dds::install_stop_handlers();
@@ -395,35 +397,7 @@ int run(int argc, char** argv) {
       return 0;
     }
     if (monitor->parsed()) {
-      PoseRecorder recorder(dds_options);
-      DiagnosticsRecorder diagnostics(dds_options);
-      const auto start = std::chrono::steady_clock::now();
-      std::size_t shown = 0;
-      while (!dds::wait_for_stop(1s)) {
-        const auto poses = recorder.poses();
-        if (poses.size() > shown) {
-          const auto& p = poses.back().row;
-          std::printf("%s %s: %zu poses (+%zu), x %.3f m, y %.3f m, yaw %.1f deg, %s\n", p.robot_id.c_str(),
-                      p.estimator.c_str(), poses.size(), poses.size() - shown, p.estimate.pose_map_base.x(),
-                      p.estimate.pose_map_base.y(), p.estimate.pose_map_base.z() * 180.0 / M_PI,
-                      to_string(p.estimate.status));
-          std::fflush(stdout);
-          shown = poses.size();
-        }
-        if (monitor_duration_s > 0.0 &&
-            std::chrono::steady_clock::now() - start > std::chrono::duration<double>(monitor_duration_s)) {
-          break;
-        }
-      }
-      const auto poses = recorder.poses();
-      if (!estimate_file.empty()) write_estimates_csv(estimate_file, rows_of(poses));
-      print_diagnostics(diagnostics.latest(), std::cout);
-      if (!truth_file.empty()) {
-        const PoseRunSummary s = summarize(poses, load_truth_csv(truth_file));
-        std::printf("poses: %zu at %.1f Hz; %s\n", s.poses, s.pose_rate_hz,
-                    format_metrics(s.metrics).c_str());
-      }
-      return 0;
+      return run_monitor({dds_options, monitor_duration_s, truth_file, estimate_file});
     }
     if (demo->parsed() || run_cmd->parsed()) {
       PipelineOptions o;

@@ -112,11 +112,11 @@ std::string join_receivers(const ReceiverArray& receivers) {
 }
 
 void print_pose_line(double t_s, const PoseRecorder& recorder) {
-  const auto poses = recorder.poses();
-  if (poses.empty()) {
+  const auto newest = recorder.newest();
+  if (!newest) {
     std::printf("t=%6.1f s  no pose yet (initializing from beacons)\n", t_s);
   } else {
-    const auto& p = poses.back().row.estimate;
+    const auto& p = newest->row.estimate;
     std::printf("t=%6.1f s  pose x %.3f m  y %.3f m  yaw %6.1f deg  %s\n", t_s, p.pose_map_base.x(),
                 p.pose_map_base.y(), p.pose_map_base.z() * 180.0 / M_PI, to_string(p.status));
   }
@@ -233,7 +233,7 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
   localizer.publish_diagnostics();
   std::this_thread::sleep_for(200ms);
   std::ostringstream diag;
-  print_diagnostics(diagnostics.latest(), diag);
+  print_diagnostics(diagnostics.reports(), diag);
   std::lock_guard<std::mutex> lock(truth_mutex);
   return finish(o, described, beacons, recorder.poses(), truth, diag.str());
 }
@@ -332,7 +332,7 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
                              std::to_string(localizer_code) + "); logs in " + o.out_dir);
   }
   std::ostringstream diag;
-  print_diagnostics(diagnostics.latest(), diag);
+  print_diagnostics(diagnostics.reports(), diag);
   return finish(o, source, beacons, recorder.poses(), load_truth_csv(o.out_dir + "/truth.csv"), diag.str());
 }
 

@@ -191,6 +191,13 @@ void LocalizerCore::on_ranges_silent(const std::string& robot_id) {
   if (it != robots_.end()) it->second.ranges_silent = true;
 }
 
+std::vector<std::string> LocalizerCore::robot_ids() const {
+  std::vector<std::string> ids;
+  ids.reserve(robots_.size());
+  for (const auto& [id, r] : robots_) ids.push_back(id);
+  return ids;
+}
+
 std::uint64_t LocalizerCore::replays() const {
   std::uint64_t n = 0;
   for (const auto& [id, r] : robots_) n += r.fusion.replays();

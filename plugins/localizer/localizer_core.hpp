@@ -64,6 +64,7 @@ class LocalizerCore {
   }
   const RejectionCounter& counts() const { return counts_; }  // reasons prefixed odometry./range.
   std::size_t robot_count() const { return robots_.size(); }
+  std::vector<std::string> robot_ids() const;  // the robots it has an estimator for, sorted
   // The worst status over the robots served (kOk when none).
   PoseStatus worst_status() const;
 

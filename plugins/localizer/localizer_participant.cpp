@@ -3,14 +3,24 @@
 #include <beaconlocPubSubTypes.h>
 
 #include <algorithm>
+#include <chrono>
 
 #include "beaconloc/dds/convert.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
 
 namespace beaconloc {
 
+namespace {
+StampNs steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+}  // namespace
+
 LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core)
     : core_(std::move(core)),
+      conflicts_(std::chrono::duration_cast<std::chrono::nanoseconds>(dds::kDiagnosticsSilentAfter).count()),
       participant_(dds, "beaconloc.localizer." + core_.estimator_name()),
       pose_writer_(participant_.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic)) {
   participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [this](const msg::BeaconMap& m) {
@@ -62,6 +72,34 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       });
   diagnostics_ =
       std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] { return diagnostics_snapshot(); });
+  own_diagnostics_writer_ = diagnostics_->writer();
+  // The other localizers' reports (1 Hz each): which robots they serve, and when they leave.
+  dds::ReaderEvents<msg::Diagnostics> peer_events;
+  peer_events.on_writer_gone = [this](const std::string& writer) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    conflicts_.on_peer_gone(writer, steady_ns());
+  };
+  peer_events.on_instance_ended = [this](const eprosima::fastdds::dds::SampleInfo& info) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    conflicts_.on_peer_gone(dds::writer_id(info.publication_handle), steady_ns());
+  };
+  participant_.subscribe_with_info<msg::DiagnosticsPubSubType>(
+      dds::kDiagnosticsTopic,
+      [this](const msg::Diagnostics& d, const eprosima::fastdds::dds::SampleInfo& info) {
+        on_peer_diagnostics(d, dds::writer_id(info.publication_handle));
+      },
+      peer_events);
+}
+
+void LocalizerParticipant::on_peer_diagnostics(const msg::Diagnostics& d, const std::string& writer) {
+  if (writer == own_diagnostics_writer_) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (d.robots_localized().size() > msg::DIAGNOSTICS_MAX_ROBOTS) {
+    ++peer_reports_refused_;  // beyond the wire contract's bound: a broken or hostile peer
+    return;
+  }
+  conflicts_.on_peer_report(writer, d.participant(),
+                            {d.robots_localized().begin(), d.robots_localized().end()}, steady_ns());
 }
 
 LocalizerParticipant::~LocalizerParticipant() {
@@ -91,13 +129,21 @@ void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
 }
 
 void LocalizerParticipant::publish(const LocalizerOutput& out) {
-  auto p = dds::to_msg(out.robot_id, out.estimate, core_.estimator_name(), out.beacons_used);
+  if (core_.robot_count() != robots_told_) {  // a new robot: is it contested? (once per robot)
+    conflicts_.set_own_robots(core_.robot_ids(), steady_ns());
+    robots_told_ = core_.robot_count();
+  }
+  PoseEstimate estimate = out.estimate;
+  estimate.status = conflicts_.status_of(out.robot_id, estimate.status);
+  auto p = dds::to_msg(out.robot_id, estimate, core_.estimator_name(), out.beacons_used);
   pose_writer_->write(&p);
   ++poses_written_;
 }
 
 msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<std::string> robots = core_.robot_ids();
+  conflicts_.set_own_robots(robots, steady_ns());  // and drops the peers gone silent
   const PoseStatus worst = core_.worst_status();
   msg::ParticipantStatus status = msg::PARTICIPANT_STATUS_OK;
   std::string message =
@@ -119,11 +165,24 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
     message += "; beacon map replaced " + std::to_string(core_.beacon_map_changes()) +
                " time(s), every robot restarted on it";
   }
+  if (conflicts_.contested_robots()) {
+    // Its poses of those robots go out degraded; the other localizer reports the same.
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message = "serving conflict: " + conflicts_.describe() + "; its poses are degraded; " + message;
+  }
+  if (robots.size() > msg::DIAGNOSTICS_MAX_ROBOTS) {
+    message += "; robots listed: the first " + std::to_string(msg::DIAGNOSTICS_MAX_ROBOTS) + " of " +
+               std::to_string(robots.size());
+    robots.resize(msg::DIAGNOSTICS_MAX_ROBOTS);
+  }
   RejectionCounter counts = core_.counts();
   counts.reject("odometry.lost_increment", lost_increments_);
+  counts.reject("diagnostics.too_many_robots", peer_reports_refused_);
   auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, deadline_misses_.load(),
                                  status, message);
   d.writers_lost(odometry_writers_lost_.load() + range_writers_lost_.load());
+  d.robots_localized(std::move(robots));
+  d.serving_conflicts(conflicts_.conflicts_found());
   return d;
 }
 

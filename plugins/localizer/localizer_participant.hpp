@@ -1,6 +1,8 @@
 #pragma once
 // localizer participant: Odometry + BeaconRange (+ BeaconMap) -> PoseEstimate, through the
-// LocalizerCore (one estimator plugin instance per robot); Diagnostics at 1 Hz.
+// LocalizerCore (one estimator plugin instance per robot); Diagnostics at 1 Hz, listing the robots
+// it serves. It reads the other participants' Diagnostics, not their poses: a robot another live
+// localizer serves too is a conflict (ServingConflicts), its poses degraded while it lasts.
 #include <beaconloc.h>
 
 #include <atomic>
@@ -12,6 +14,7 @@
 #include "beaconloc/dds/diagnostics_publisher.hpp"
 #include "beaconloc/dds/participant.hpp"
 #include "localizer_core.hpp"
+#include "serving_conflicts.hpp"
 
 namespace beaconloc {
 
@@ -36,9 +39,14 @@ class LocalizerParticipant {
   msg::Diagnostics diagnostics_snapshot();
   void on_odometry(const msg::Odometry& odometry);
   void publish(const LocalizerOutput& out);  // under mutex_
+  void on_peer_diagnostics(const msg::Diagnostics& d, const std::string& writer);
 
   std::mutex mutex_;
   LocalizerCore core_;
+  ServingConflicts conflicts_;
+  std::string own_diagnostics_writer_;      // its own reports come back to its reader: not a peer
+  std::uint64_t peer_reports_refused_ = 0;  // listing more than DIAGNOSTICS_MAX_ROBOTS robots
+  std::size_t robots_told_ = 0;             // robots the conflicts know it serves (robots are never removed)
   std::atomic<std::uint64_t> deadline_misses_{0};
   std::atomic<std::uint64_t> odometry_writers_lost_{0};
   std::map<std::string, std::uint64_t> odometry_sequence_;  // newest sequence number per robot

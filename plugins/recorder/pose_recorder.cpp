@@ -6,14 +6,19 @@
 
 namespace beaconloc {
 
-PoseRecorder::PoseRecorder(const dds::DdsOptions& dds) : participant_(dds, "beaconloc.pose_recorder") {
-  participant_.subscribe<msg::PoseEstimatePubSubType>(
-      dds::kPoseEstimateTopic, [this](const msg::PoseEstimate& m) {
+PoseRecorder::PoseRecorder(const dds::DdsOptions& dds, Keep keep)
+    : keep_(keep), participant_(dds, "beaconloc.pose_recorder") {
+  participant_.subscribe_with_info<msg::PoseEstimatePubSubType>(
+      dds::kPoseEstimateTopic,
+      [this](const msg::PoseEstimate& m, const eprosima::fastdds::dds::SampleInfo& info) {
         RecordedPose p{{m.robot_id(), dds::from_msg(m), m.estimator()}, std::chrono::steady_clock::now()};
         std::lock_guard<std::mutex> lock(mutex_);
-        auto [newest, first] = newest_of_robot_.try_emplace(p.row.robot_id, poses_.size());
-        if (!first && poses_[newest->second].row.estimate.stamp_ns == p.row.estimate.stamp_ns) {
-          poses_[newest->second] = std::move(p);  // a correction of the same pose
+        const std::string writer = dds::writer_id(info.publication_handle);
+        const PoseTally::Added added = tally_.add(p, writer);
+        if (keep_ != Keep::kEveryPose || added == PoseTally::Added::kNonFinite) return;
+        auto [newest, first] = newest_of_writer_.try_emplace({p.row.robot_id, writer}, poses_.size());
+        if (!first && added == PoseTally::Added::kCorrection) {
+          poses_[newest->second] = std::move(p);
           return;
         }
         newest->second = poses_.size();
@@ -25,17 +30,40 @@ PoseRecorder::~PoseRecorder() { participant_.close(); }
 
 std::vector<RecordedPose> PoseRecorder::poses() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return poses_;
+  if (keep_ == Keep::kEveryPose) return poses_;
+  std::vector<RecordedPose> newest;
+  for (const auto& [id, r] : tally_.robots()) {
+    if (r.newest) newest.push_back(*r.newest);
+  }
+  return newest;
 }
 
 std::size_t PoseRecorder::count() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return poses_.size();
+  return tally_.poses();
+}
+
+std::size_t PoseRecorder::stored() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (keep_ == Keep::kEveryPose) return poses_.size();
+  std::size_t n = 0;
+  for (const auto& [id, r] : tally_.robots()) n += r.newest ? 1 : 0;
+  return n;
 }
 
 StampNs PoseRecorder::newest_stamp_ns() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return poses_.empty() ? 0 : poses_.back().row.estimate.stamp_ns;
+  return tally_.newest() ? tally_.newest()->row.estimate.stamp_ns : 0;
+}
+
+std::optional<RecordedPose> PoseRecorder::newest() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return tally_.newest();
+}
+
+std::map<std::string, RobotPoses> PoseRecorder::robots() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return tally_.robots();
 }
 
 std::vector<EstimateRow> rows_of(const std::vector<RecordedPose>& poses) {

@@ -86,7 +86,7 @@ TEST_F(BadInput, DecoderRefusesEveryBadTofByReason) {
     ASSERT_EQ(tof_writer->write(&m), true);
   }
   const auto d = diagnostics_of(diagnostics, "beaconloc.decoder", 4);
-  print_diagnostics({{"beaconloc.decoder", d}}, std::cout);
+  print_report("beaconloc.decoder", ParticipantReport{d}, std::cout);
   EXPECT_EQ(d.accepted(), 4u);
   EXPECT_EQ(rejected_count(d, "non_finite_tof"), 2u);
   EXPECT_EQ(rejected_count(d, "negative_tof"), 1u);
@@ -177,7 +177,7 @@ TEST_F(BadInput, LocalizerRefusesEveryBadSampleByReason) {
   for (auto& m : ranges) range_writer->write(&m);
 
   const auto d = diagnostics_of(diagnostics, "beaconloc.localizer.range_ekf", good_odometry + 1);
-  print_diagnostics({{"localizer", d}}, std::cout);
+  print_report("localizer", ParticipantReport{d}, std::cout);
   EXPECT_EQ(d.accepted(), good_odometry + 1);
   EXPECT_EQ(rejected_count(d, "odometry.duplicate_odometry"), 1u);
   EXPECT_EQ(rejected_count(d, "odometry.out_of_order_odometry"), 1u);

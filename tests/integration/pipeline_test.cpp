@@ -64,7 +64,7 @@ TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
 
   // Every participant reports what it accepted and refused, by reason.
   const auto latest = diagnostics.latest();
-  print_diagnostics(latest, std::cout);
+  print_diagnostics(diagnostics.reports(), std::cout);
   ASSERT_EQ(latest.count("beaconloc.gateway.robot7"), 1u);
   ASSERT_EQ(latest.count("beaconloc.decoder"), 1u);
   ASSERT_EQ(latest.count("beaconloc.localizer.range_ekf"), 1u);

@@ -9,7 +9,7 @@ DiagnosticsPublisher::DiagnosticsPublisher(Participant& participant,
     : participant_(participant),
       snapshot_(std::move(snapshot)),
       writer_(participant.writer<msg::DiagnosticsPubSubType>(kDiagnosticsTopic)),
-      task_(std::make_unique<PeriodicTask>(std::chrono::seconds(1), [this] { publish_now(); })) {}
+      task_(std::make_unique<PeriodicTask>(kDiagnosticsPeriod, [this] { publish_now(); })) {}
 
 void DiagnosticsPublisher::publish_now() {
   msg::Diagnostics d = snapshot_();
@@ -27,6 +27,15 @@ void DiagnosticsPublisher::stop() {
   if (!task_) return;
   task_.reset();
   publish_now();
+  // Every participant's Diagnostics are keyed by its name (dds::make_diagnostics).
+  msg::Diagnostics key;
+  key.participant(participant_.name());
+  writer_->dispose(&key, eprosima::fastdds::dds::HANDLE_NIL);
+  // Readers acknowledge both at once when nothing is lost; a lost one is repaired only while the
+  // writer lives. Bounded: a reader that died unnoticed never acknowledges.
+  writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0, 200'000'000));
 }
+
+std::string DiagnosticsPublisher::writer() const { return writer_id(writer_->get_instance_handle()); }
 
 }  // namespace beaconloc::dds

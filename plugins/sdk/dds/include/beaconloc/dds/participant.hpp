@@ -18,6 +18,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -52,26 +53,52 @@ struct ReaderEvents {
   // True from a writer's loss of liveliness until a writer is alive again (a writer that leaves
   // cleanly is not lost).
   std::atomic<bool>* lost_and_none_alive = nullptr;
+  // A writer of the topic is gone: unmatched (deleted, its participant left or was lost) or its
+  // liveliness lost; the id is writer_id() of its samples' SampleInfo::publication_handle.
+  std::function<void(const std::string& writer)> on_writer_gone;
+  // A sample without data: its writer disposed or unregistered the instance (info.instance_state).
+  std::function<void(const eprosima::fastdds::dds::SampleInfo& info)> on_instance_ended;
 };
 
-// Takes every valid sample a reader has and hands it to a callback; counts missed deadlines and
-// writers that lost liveliness.
+// A writer's identity, as the DDS-free code keys it (the hex digits of its GUID).
+inline std::string writer_id(const eprosima::fastdds::dds::InstanceHandle_t& publication_handle) {
+  std::ostringstream s;
+  s << std::hex;
+  for (int i = 0; i < 16; ++i) {
+    const int octet = publication_handle.value[i];
+    s << (octet < 16 ? "0" : "") << octet;
+  }
+  return s.str();
+}
+
+// Takes every valid sample a reader has and hands it to a callback with its SampleInfo; counts
+// missed deadlines and writers that lost liveliness, and tells which writers went away.
 template <class Msg>
 class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
  public:
-  SampleListener(std::function<void(const Msg&)> on_sample, ReaderEvents<Msg> events)
+  using OnSample = std::function<void(const Msg&, const eprosima::fastdds::dds::SampleInfo&)>;
+  SampleListener(OnSample on_sample, ReaderEvents<Msg> events)
       : on_sample_(std::move(on_sample)), events_(std::move(events)) {}
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
     Msg m;
     eprosima::fastdds::dds::SampleInfo info;
     while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
+      if (!info.valid_data) {
+        if (events_.on_instance_ended) events_.on_instance_ended(info);
+        continue;
+      }
       if (events_.on_deadline_missed) {
         // Fast DDS 2.9's DataReader::get_key_value is unsupported: keep each instance's key.
         std::lock_guard<std::mutex> lock(keys_mutex_);
         if (!keys_.count(info.instance_handle)) keys_.emplace(info.instance_handle, m);
       }
-      on_sample_(m);
+      on_sample_(m, info);
+    }
+  }
+  void on_subscription_matched(eprosima::fastdds::dds::DataReader*,
+                               const eprosima::fastdds::dds::SubscriptionMatchedStatus& s) override {
+    if (events_.on_writer_gone && s.current_count_change < 0) {
+      events_.on_writer_gone(writer_id(s.last_publication_handle));
     }
   }
   void on_requested_deadline_missed(eprosima::fastdds::dds::DataReader*,
@@ -99,10 +126,13 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
         *events_.lost_and_none_alive = true;
       }
     }
+    if (events_.on_writer_gone && s.not_alive_count_change > 0) {
+      events_.on_writer_gone(writer_id(s.last_publication_handle));
+    }
   }
 
  private:
-  std::function<void(const Msg&)> on_sample_;
+  OnSample on_sample_;
   ReaderEvents<Msg> events_;
   std::mutex keys_mutex_;
   std::map<eprosima::fastdds::dds::InstanceHandle_t, Msg> keys_;  // a sample of each instance seen
@@ -139,10 +169,27 @@ class Participant {
   eprosima::fastdds::dds::DataReader* subscribe(
       const TopicSpec& spec, std::function<void(const typename PubSubType::type&)> on_sample,
       ReaderEvents<typename PubSubType::type> events) {
+    return subscribe_with_info<PubSubType>(
+        spec,
+        [on_sample = std::move(on_sample)](const typename PubSubType::type& m,
+                                           const eprosima::fastdds::dds::SampleInfo&) { on_sample(m); },
+        std::move(events));
+  }
+  // The same, with each sample's SampleInfo (its writer: publication_handle).
+  template <class PubSubType>
+  eprosima::fastdds::dds::DataReader* subscribe_with_info(
+      const TopicSpec& spec, typename SampleListener<typename PubSubType::type>::OnSample on_sample,
+      ReaderEvents<typename PubSubType::type> events = {}) {
     listeners_.push_back(
         std::make_unique<SampleListener<typename PubSubType::type>>(std::move(on_sample), std::move(events)));
+    return reader<PubSubType>(spec, listeners_.back().get());
+  }
+  // A reader with a listener of the caller's, who keeps it alive until close().
+  template <class PubSubType>
+  eprosima::fastdds::dds::DataReader* reader(const TopicSpec& spec,
+                                             eprosima::fastdds::dds::DataReaderListener* listener) {
     return make_reader(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.reader_profile,
-                       listeners_.back().get());
+                       listener);
   }
   const std::string& name() const { return name_; }
   // Samples whose payload could not be read, on any topic (Fast DDS dropped them).

@@ -1,0 +1,47 @@
+#include "pose_tally.hpp"
+
+namespace beaconloc {
+
+std::vector<const PoseWriter*> RobotPoses::current_writers(std::chrono::steady_clock::time_point now) const {
+  std::vector<const PoseWriter*> out;
+  for (const auto& [id, w] : writers) {
+    if (now - w.last_heard <= kConcurrentWritersWithin) out.push_back(&w);
+  }
+  return out;
+}
+
+bool is_finite(const PoseEstimate& e) { return e.pose_map_base.allFinite() && e.covariance.allFinite(); }
+
+PoseTally::Added PoseTally::add(const RecordedPose& p, const std::string& writer) {
+  RobotPoses& r = robots_[p.row.robot_id];
+  if (!is_finite(p.row.estimate)) {
+    ++r.non_finite;
+    return Added::kNonFinite;
+  }
+  auto [entry, first_of_writer] = r.writers.try_emplace(writer);
+  PoseWriter& w = entry->second;
+  // (Two localizers of one robot publish at the same odometry stamps: one's pose is no
+  // correction of the other's.)
+  const bool correction = !first_of_writer && w.newest_stamp_ns == p.row.estimate.stamp_ns;
+  w.estimator = p.row.estimator;
+  w.newest_stamp_ns = p.row.estimate.stamp_ns;
+  w.last_heard = p.received;
+  if (r.writers.size() > 1 && r.current_writers(p.received).size() > 1) r.had_conflict = true;
+  // A writer not heard for long, that was never part of a conflict, is forgotten: the state
+  // stays O(robots) over restarts of a robot's localizer.
+  if (!r.had_conflict) {
+    for (auto it = r.writers.begin(); it != r.writers.end();) {
+      it =
+          p.received - it->second.last_heard > kConcurrentWritersWithin ? r.writers.erase(it) : std::next(it);
+    }
+  }
+  r.newest = p;
+  newest_ = p;
+  if (correction) return Added::kCorrection;
+  ++w.poses;
+  ++r.poses;
+  ++poses_;
+  return Added::kNew;
+}
+
+}  // namespace beaconloc
