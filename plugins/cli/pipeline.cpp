@@ -266,11 +266,13 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
   PoseRecorder recorder(o.dds);
   DiagnosticsRecorder diagnostics(o.dds);
 
+  const LocalizerSettings localizer_settings = with_scenario_defaults(o.localizer, source, o.out_dir);
+  // An unknown estimator or a bad parameter fails here, at start, rather than in the child's log.
+  [[maybe_unused]] const LocalizerCore checked(localizer_settings.estimator,
+                                               localizer_settings.config(receivers));
   auto localizer_args = std::vector<std::string>{"localizer"};
   for (const auto& a : dds_arguments(o.dds)) localizer_args.push_back(a);
-  for (const auto& a : with_scenario_defaults(o.localizer, source, o.out_dir).arguments(receivers)) {
-    localizer_args.push_back(a);
-  }
+  for (const auto& a : localizer_settings.arguments(receivers)) localizer_args.push_back(a);
   auto decoder_args = std::vector<std::string>{"decoder"};
   for (const auto& a : dds_arguments(o.dds)) decoder_args.push_back(a);
   for (const auto& a : std::vector<std::string>{

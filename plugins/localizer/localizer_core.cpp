@@ -229,6 +229,39 @@ PoseStatus LocalizerCore::Robot::status() const {
   return estimator_status;
 }
 
+std::optional<StartupWait> LocalizerCore::startup_wait(const std::string& robot_id) const {
+  const auto it = robots_.find(robot_id);
+  if (it == robots_.end()) return std::nullopt;
+  return it->second.fusion.estimator().startup_wait();
+}
+
+StartupSummary LocalizerCore::startup_summary() const {
+  StartupSummary s;
+  for (const auto& [id, r] : robots_) {  // by robot id
+    const std::optional<StartupWait> wait = r.fusion.estimator().startup_wait();
+    if (!wait) continue;
+    if (s.empty()) {
+      s.first_robot = id;
+      s.first_wait = *wait;
+    }
+    ++s.robots_by_condition[wait->condition];
+  }
+  return s;
+}
+
+std::string StartupSummary::describe() const {
+  std::size_t total = 0;
+  std::string conditions;
+  for (const auto& [condition, n] : robots_by_condition) {
+    total += n;
+    conditions +=
+        (conditions.empty() ? "" : ", ") + std::string(to_string(condition)) + " " + std::to_string(n);
+  }
+  if (total == 0) return {};
+  return std::to_string(total) + " initializing: " + conditions + " (robot " + first_robot + ": " +
+         first_wait.describe() + ")";
+}
+
 PoseStatus LocalizerCore::worst_status() const {
   PoseStatus worst = PoseStatus::kOk;
   for (const auto& [id, r] : robots_) {

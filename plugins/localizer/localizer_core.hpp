@@ -21,6 +21,17 @@ struct LocalizerOutput {
   std::vector<std::uint32_t> beacons_used;  // beacons fused since the previous output
 };
 
+// Why the robots without a pose have none: how many wait for each start-up condition, and the
+// first of them (by robot id) with the numbers that matter. Short for many robots.
+struct StartupSummary {
+  std::map<StartupCondition, std::size_t> robots_by_condition;
+  std::string first_robot;
+  StartupWait first_wait;
+  bool empty() const { return robots_by_condition.empty(); }
+  // "2 initializing: too_few_beacons 1, mirror_ambiguous 1 (robot a: 2 of 3 beacons heard)"
+  std::string describe() const;
+};
+
 class LocalizerCore {
  public:
   // Throws UnknownEstimator when no estimator has that name. An empty robot_filter serves
@@ -67,6 +78,9 @@ class LocalizerCore {
   std::vector<std::string> robot_ids() const;  // the robots it has an estimator for, sorted
   // The worst status over the robots served (kOk when none).
   PoseStatus worst_status() const;
+  // The robot's start-up condition while it has no pose (nullopt once it has one, or unknown).
+  std::optional<StartupWait> startup_wait(const std::string& robot_id) const;
+  StartupSummary startup_summary() const;
 
  private:
   struct Robot {

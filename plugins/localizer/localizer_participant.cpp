@@ -160,6 +160,9 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   } else if (worst == PoseStatus::kDegraded || worst == PoseStatus::kLost) {
     status = msg::PARTICIPANT_STATUS_DEGRADED;
   }
+  // The robots without a pose yet, and what they wait for.
+  if (const StartupSummary startup = core_.startup_summary(); !startup.empty())
+    message += "; " + startup.describe();
   message += "; " + std::to_string(core_.replays()) + " late measurement(s) fused at their stamp";
   if (core_.beacon_map_changes()) {
     message += "; beacon map replaced " + std::to_string(core_.beacon_map_changes()) +

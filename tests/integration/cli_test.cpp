@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <filesystem>
 #include <fstream>
 #include <thread>
 
@@ -70,6 +71,40 @@ TEST(Cli, BadArgumentsAndConfigurationNameTheCulpritAndFail) {
     EXPECT_NE(out.find(c.must_name), std::string::npos) << joined << "\n" << out;
   }
   std::remove(bad_xml.c_str());
+}
+
+// A mistyped or out-of-range --param stops every command that creates an estimator at start,
+// naming the parameter (and the known ones, or the range), before any data flows.
+TEST(Cli, EveryCommandRefusesABadEstimatorParameterAtStart) {
+  DomainLease domain;
+  const std::string scenario = std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/default.yaml";
+  const std::string out = "/tmp/beaconloc-cli-param-" + std::to_string(domain.id());
+  const std::vector<std::vector<std::string>> commands = {
+      {"localizer", "--domain", std::to_string(domain.id())},
+      {"run", "--domain", std::to_string(domain.id()), "--out", out},
+      {"run", "--domain", std::to_string(domain.id()), "--out", out, "--processes", "--speed", "5"},
+      {"demo", "--domain", std::to_string(domain.id())},
+      {"accuracy", "--scenario", scenario, "--seeds", "1"},
+  };
+  for (auto args : commands) {
+    std::string joined;
+    for (const auto& a : args) joined += a + " ";
+    auto typo = args;
+    typo.insert(typo.end(), {"--param", "nis_gat=3"});
+    auto [code, text] = beaconloc(typo);
+    EXPECT_EQ(code, 2) << joined << "\n" << text;
+    EXPECT_NE(text.find("range_ekf: unknown parameter 'nis_gat' (known: nis_gate,"), std::string::npos)
+        << joined << "\n"
+        << text;
+    EXPECT_EQ(text.find("poses:"), std::string::npos) << joined << ": ran anyway\n" << text;
+    auto negative = args;
+    negative.insert(negative.end(), {"--param", "nis_gate=-1"});
+    auto [negative_code, negative_text] = beaconloc(negative);
+    EXPECT_EQ(negative_code, 2) << joined << "\n" << negative_text;
+    EXPECT_NE(negative_text.find("nis_gate=-1 is outside (0, 1000]"), std::string::npos) << joined << "\n"
+                                                                                         << negative_text;
+  }
+  std::filesystem::remove_all(out);
 }
 
 TEST(Cli, ParticipantsStopCleanlyOnSigintAndSigterm) {

@@ -75,5 +75,36 @@ TEST(RangePoseSolver, RefusesTooFewRangesAndInconsistentOnes) {
   EXPECT_EQ(solve_pose_from_ranges(obs).failure, "invalid_observation");
 }
 
+// The fix's mirror image across the beacons' principal axis: as good a fit when the beacons are
+// on one line and the receiver's path is symmetric about it (one receiver driving straight),
+// far worse when identified receivers on a circle break the symmetry or the beacons spread.
+TEST(RangePoseSolver, ReportsHowMuchWorseTheMirrorImageFits) {
+  const std::vector<Eigen::Vector3d> row = {{0.0, 0.0, 2.5}, {2.0, 0.0, 2.5}, {4.0, 0.0, 2.5}};
+  const Pose2 now(1.5, 1.2, 0.3);
+  std::vector<RangeObservation> straight;
+  for (int k = 0; k < 4; ++k) {
+    const Pose2 then_in_now(-0.3 * k, 0.0, 0.0);  // one receiver at the centre, driving straight
+    for (const auto& b : row) {
+      RangeObservation o;
+      o.receiver_solve_frame_m = then_in_now.head<2>();
+      o.beacon_map_m = b;
+      o.range_m = predict_range(compose(now, then_in_now), Eigen::Vector2d::Zero(), 0.0, b).range_m;
+      straight.push_back(o);
+    }
+  }
+  const auto one = solve_pose_from_ranges(straight);
+  ASSERT_TRUE(one.ok) << one.failure;
+  EXPECT_LT(one.mirror_cost_margin, 1e-6);  // the ranges cannot say which side of the row
+
+  const auto ring = solve_pose_from_ranges(observe(now, row, ReceiverArray::on_circle(0.19, 3)));
+  ASSERT_TRUE(ring.ok) << ring.failure;
+  EXPECT_NEAR((ring.pose - now).norm(), 0.0, 1e-6);
+  EXPECT_GT(ring.mirror_cost_margin, 100.0);  // receivers 1 and 2 would swap sides
+
+  const auto spread = solve_pose_from_ranges(observe(now, kTriangle, ReceiverArray::on_circle(0.19, 3)));
+  ASSERT_TRUE(spread.ok) << spread.failure;
+  EXPECT_GT(spread.mirror_cost_margin, 1000.0);
+}
+
 }  // namespace
 }  // namespace beaconloc

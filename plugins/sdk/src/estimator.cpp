@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -44,9 +45,71 @@ std::map<std::string, double> parse_estimator_parameters(const std::vector<std::
     if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(v)) {
       throw std::invalid_argument(option_name + " '" + item + "': '" + value + "' is not a number");
     }
-    out[item.substr(0, eq)] = v;
+    if (!out.emplace(item.substr(0, eq), v).second) {
+      throw std::invalid_argument(option_name + " '" + item + "': " + item.substr(0, eq) + " is given twice");
+    }
   }
   return out;
+}
+
+const char* to_string(StartupCondition c) {
+  switch (c) {
+    case StartupCondition::kNoBeaconMap:
+      return "no_beacon_map";
+    case StartupCondition::kNoOdometry:
+      return "no_odometry";
+    case StartupCondition::kNeedsInitialPose:
+      return "needs_initial_pose";
+    case StartupCondition::kTooFewBeacons:
+      return "too_few_beacons";
+    case StartupCondition::kTooFewRanges:
+      return "too_few_ranges";
+    case StartupCondition::kFixFailed:
+      return "fix_failed";
+    case StartupCondition::kMirrorAmbiguous:
+      return "mirror_ambiguous";
+    case StartupCondition::kPositionTooUncertain:
+      return "position_too_uncertain";
+    case StartupCondition::kHeadingTooUncertain:
+      return "heading_too_uncertain";
+  }
+  return "unknown";
+}
+
+std::string StartupWait::describe() const {
+  char text[160];
+  switch (condition) {
+    case StartupCondition::kNoBeaconMap:
+      std::snprintf(text, sizeof text, "no beacon map");
+      break;
+    case StartupCondition::kNoOdometry:
+      std::snprintf(text, sizeof text, "no odometry yet");
+      break;
+    case StartupCondition::kNeedsInitialPose:
+      std::snprintf(text, sizeof text, "needs an initial pose (--initial-pose or initial_pose)");
+      break;
+    case StartupCondition::kTooFewBeacons:
+      std::snprintf(text, sizeof text, "%.0f of %.0f beacons heard", value, limit);
+      break;
+    case StartupCondition::kTooFewRanges:
+      std::snprintf(text, sizeof text, "%.0f of %.0f ranges", value, limit);
+      break;
+    case StartupCondition::kFixFailed:
+      std::snprintf(text, sizeof text, "no global fix");
+      break;
+    case StartupCondition::kMirrorAmbiguous:
+      std::snprintf(text, sizeof text,
+                    "beacons on one line, mirror image fits as well (chi-square margin %.1f < %.1f)", value,
+                    limit);
+      break;
+    case StartupCondition::kPositionTooUncertain:
+      std::snprintf(text, sizeof text, "fix too uncertain: position sigma %.2f m > %.2f m", value, limit);
+      break;
+    case StartupCondition::kHeadingTooUncertain:
+      std::snprintf(text, sizeof text, "fix too uncertain: heading sigma %.2f rad > %.2f rad", value, limit);
+      break;
+  }
+  return note.empty() ? std::string(text) : std::string(text) + " (" + note + ")";
 }
 
 InputResult check_range(const RangeMeasurement& r, const BeaconMap& map, std::size_t receiver_count) {

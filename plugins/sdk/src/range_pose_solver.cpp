@@ -1,6 +1,8 @@
 #include "beaconloc/core/solvers/range_pose_solver.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -116,13 +118,42 @@ Refined best_of_starts(const std::vector<RangeObservation>& observations,
   return best;
 }
 
+// Chi-square, 3 dof, 99.9 %: two minima closer than this in the fix's information are one.
+constexpr double kSameMinimumChiSquare = 16.27;
+
+// The pose reflected across the principal axis of the observations' beacons (map xy): with the
+// beacons on one line, the ranges from receivers mirrored across it are the same.
+Pose2 mirrored_across_beacon_axis(const std::vector<RangeObservation>& obs, const Pose2& pose) {
+  std::vector<Eigen::Vector2d> beacons;
+  for (const auto& o : obs) {
+    const Eigen::Vector2d b = o.beacon_map_m.head<2>();
+    if (std::find(beacons.begin(), beacons.end(), b) == beacons.end()) beacons.push_back(b);
+  }
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& b : beacons) mean += b;
+  mean /= static_cast<double>(beacons.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (const auto& b : beacons) scatter += (b - mean) * (b - mean).transpose();
+  // Eigenvalues ascending: the last eigenvector is the axis along which the beacons spread most.
+  const Eigen::Vector2d axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter).eigenvectors().col(1);
+  const Eigen::Matrix2d reflection = 2.0 * axis * axis.transpose() - Eigen::Matrix2d::Identity();
+  const Eigen::Vector2d position = mean + reflection * (pose.head<2>() - mean);
+  const double axis_angle = std::atan2(axis.y(), axis.x());
+  return {position.x(), position.y(), wrap_angle_rad(2.0 * axis_angle - pose.z())};
+}
+
+bool same_minimum(const Refined& a, const Refined& b) {
+  const Eigen::Vector3d d = pose_difference(a.pose, b.pose);
+  return d.dot(b.information * d) < kSameMinimumChiSquare;
+}
+
 }  // namespace
 
 RangePoseSolution solve_pose_from_ranges(const std::vector<RangeObservation>& all_observations,
                                          const RangePoseSolverOptions& options) {
   std::vector<RangeObservation> observations = all_observations;
   RangePoseSolution solution;
-  if (observations.size() < 4) {
+  if (observations.size() < kRangePoseMinObservations) {
     solution.failure = "too_few_ranges";
     return solution;
   }
@@ -143,7 +174,7 @@ RangePoseSolution solve_pose_from_ranges(const std::vector<RangeObservation>& al
     for (;;) {
       const auto [worst, sigma] = worst_residual(observations, best.pose);
       if (sigma <= options.outlier_gate_sigma) break;
-      if (solution.outliers >= max_outliers || observations.size() <= 4) {
+      if (solution.outliers >= max_outliers || observations.size() <= kRangePoseMinObservations) {
         solution.failure = "too_many_outliers";
         return solution;
       }
@@ -164,6 +195,12 @@ RangePoseSolution solve_pose_from_ranges(const std::vector<RangeObservation>& al
       if (again.converged && again.cost < best.cost) best = again;
     }
   }
+  const Refined mirror =
+      refine(observations, mirrored_across_beacon_axis(observations, best.pose), options.max_iterations);
+  if (mirror.converged && !same_minimum(mirror, best)) {
+    solution.mirror_cost_margin = std::abs(mirror.cost - best.cost);
+    if (mirror.cost < best.cost) best = mirror;  // the starts missed it: the mirror is the fix
+  }
   solution.weighted_residual_rms = std::sqrt(best.cost / static_cast<double>(observations.size()));
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(best.information);
   if (ldlt.info() != Eigen::Success || (ldlt.vectorD().array() <= 1e-12).any()) {
@@ -178,6 +215,16 @@ RangePoseSolution solve_pose_from_ranges(const std::vector<RangeObservation>& al
   }
   solution.ok = true;
   return solution;
+}
+
+double truncated_range_cost(const std::vector<RangeObservation>& obs, const Pose2& pose, double cap_sigma) {
+  double cost = 0.0;
+  for (const auto& o : obs) {
+    const double r =
+        o.range_m - predict_range(pose, o.receiver_solve_frame_m, o.receiver_z_m, o.beacon_map_m).range_m;
+    cost += std::min(r * r / o.variance_m2, cap_sigma * cap_sigma);
+  }
+  return cost;
 }
 
 }  // namespace beaconloc

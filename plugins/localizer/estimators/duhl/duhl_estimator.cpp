@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "beaconloc/core/estimator_parameters.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/models/diff_drive_motion.hpp"
 
@@ -26,12 +27,14 @@ bool three_on_a_circle(const EstimatorConfig& config) {
   return true;
 }
 
-UhlOptions uhl_options(const EstimatorConfig& config) {
+UhlOptions uhl_options(const EstimatorConfig& config, ParameterReader& in) {
   UhlOptions o;
   const ReceiverRing ring = ring_of(config);
   o.receiver_radius_m = ring.radius_m;
   o.receiver_height_m = ring.height_m;
-  o.collinear_threshold_m = config.parameter("uhl_collinear_threshold_m", o.collinear_threshold_m);
+  // A distance from the Txs' line, within a room.
+  o.collinear_threshold_m =
+      in.real("uhl_collinear_threshold_m", o.collinear_threshold_m, ParameterRange::above(0.0, 10.0));
   return o;
 }
 
@@ -52,16 +55,21 @@ Cov3 uhl_observation_covariance(const std::vector<TxDistances>& txs, const UhlSo
 }
 
 DuhlParameters DuhlParameters::from(const EstimatorConfig& c) {
+  namespace ranges = parameter_ranges;
+  ParameterReader in(c, "duhl");
   DuhlParameters p;
-  p.uhl = uhl_options(c);
-  p.discard_variance_m2 = c.parameter("discard_variance_m2", p.discard_variance_m2);
-  p.observation_nis_gate = c.parameter("observation_nis_gate", p.observation_nis_gate);
-  p.max_odometry_gap_s = c.parameter("max_odometry_gap_s", p.max_odometry_gap_s);
-  p.reinitialize_after_gated =
-      static_cast<int>(c.parameter("reinitialize_after_gated", p.reinitialize_after_gated));
-  p.observation_covariance_as_printed = c.parameter("observation_covariance_as_printed",
-                                                    p.observation_covariance_as_printed ? 1.0 : 0.0) != 0.0;
-  p.distance_innovation_gate = c.parameter("distance_innovation_gate", p.distance_innovation_gate);
+  p.uhl = uhl_options(c, in);
+  // A distance variance: positive, at most (1 m)^2 (the paper's sigma_dd is 1 cm).
+  p.discard_variance_m2 =
+      in.real("discard_variance_m2", p.discard_variance_m2, ParameterRange::above(0.0, 1.0));
+  p.observation_nis_gate = in.real("observation_nis_gate", p.observation_nis_gate, ranges::kChiSquareGate);
+  p.max_odometry_gap_s = in.real("max_odometry_gap_s", p.max_odometry_gap_s, ranges::kDataDurationS);
+  p.reinitialize_after_gated = in.count("reinitialize_after_gated", p.reinitialize_after_gated, 0, 1000);
+  p.observation_covariance_as_printed =
+      in.flag("observation_covariance_as_printed", p.observation_covariance_as_printed);
+  p.distance_innovation_gate =
+      in.real("distance_innovation_gate", p.distance_innovation_gate, ranges::kChiSquareGateOrOff);
+  in.finish();
   return p;
 }
 
@@ -183,12 +191,15 @@ Cov3 Duhl::observation_covariance(const std::vector<TxDistances>& txs, const Uhl
 
 void Duhl::observe() {
   pending_observation_ = false;
-  if (available_.size() < 2) return;
+  if (available_.size() < kMinTxs) return;
   std::vector<TxDistances> txs;
   txs.reserve(available_.size());
   for (const auto& [id, e] : available_) txs.push_back({map_.find(id)->position_map_m, e.q});
   const UhlSolution z = solve_uhl(txs, params_.uhl);
-  if (!z.ok) return;
+  if (!z.ok) {
+    uhl_failure_ = z.failure;
+    return;
+  }
   const Cov3 r = observation_covariance(txs, z);
   const StampNs now = *timeline_.last_stamp_ns();
   if (!initialized_) {
@@ -227,14 +238,34 @@ std::optional<PoseEstimate> Duhl::estimate() const {
   return PoseEstimate{*timeline_.last_stamp_ns(), ekf_.state(), ekf_.covariance(), status()};
 }
 
+std::optional<StartupWait> Duhl::startup_wait() const {
+  if (estimate()) return std::nullopt;
+  if (map_.empty()) return StartupWait{StartupCondition::kNoBeaconMap, 0.0, 0.0, {}};
+  if (!timeline_.last_stamp_ns()) return StartupWait{StartupCondition::kNoOdometry, 0.0, 0.0, {}};
+  if (available_.size() < kMinTxs) {
+    return StartupWait{StartupCondition::kTooFewBeacons,
+                       static_cast<double>(available_.size()),
+                       static_cast<double>(kMinTxs),
+                       {}};
+  }
+  return StartupWait{StartupCondition::kFixFailed, 0.0, 0.0, "uhl: " + uhl_failure_};
+}
+
 PoseStatus Duhl::status() const {
   if (!initialized_) return PoseStatus::kInitializing;
   return staleness_.classify(timeline_.last_stamp_ns().value_or(last_correction_stamp_ns_),
                              last_correction_stamp_ns_);
 }
 
+UhlOptions UhlLast2::options_from(const EstimatorConfig& config) {
+  ParameterReader in(config, "uhl_last2");
+  const UhlOptions o = uhl_options(config, in);
+  in.finish();
+  return o;
+}
+
 UhlLast2::UhlLast2(const EstimatorConfig& config)
-    : ring_(ring_of(config)), uhl_(uhl_options(config)), timeline_(0.2) {
+    : ring_(ring_of(config)), uhl_(options_from(config)), timeline_(0.2) {
   if (!three_on_a_circle(config)) {
     throw std::invalid_argument(
         "uhl_last2 needs three receivers on a circle at 0, 120, 240 degrees (seed 000 eq. 1)");
@@ -249,14 +280,18 @@ InputResult UhlLast2::predict(const OdometrySample& o) {
   // The last two Txs heard by all three receivers.
   std::vector<TxDistances> txs;
   std::vector<DistanceCov> covariances;
-  for (auto it = firings_.rbegin(); it != firings_.rend() && txs.size() < 2; ++it) {
+  for (auto it = firings_.rbegin(); it != firings_.rend() && txs.size() < kMinTxs; ++it) {
     if (!(it->heard[0] && it->heard[1] && it->heard[2])) continue;
     txs.push_back({map_.find(it->beacon_id)->position_map_m, it->d});
     covariances.push_back(it->variance_m2 * DistanceCov::Identity());
   }
-  if (txs.size() < 2) return InputResult::ok();
+  heard_by_all_ = txs.size();
+  if (txs.size() < kMinTxs) return InputResult::ok();
   const UhlSolution z = solve_uhl(txs, uhl_);
-  if (!z.ok) return InputResult::ok();
+  if (!z.ok) {
+    uhl_failure_ = z.failure;
+    return InputResult::ok();
+  }
   last_ = PoseEstimate{o.stamp_ns, z.pose,
                        uhl_observation_covariance(txs, z, covariances, uhl_) + 1e-9 * Cov3::Identity(),
                        PoseStatus::kOk};
@@ -287,6 +322,17 @@ std::optional<PoseEstimate> UhlLast2::estimate() const {
   e.stamp_ns = *timeline_.last_stamp_ns();
   e.status = status();
   return e;
+}
+
+std::optional<StartupWait> UhlLast2::startup_wait() const {
+  if (estimate()) return std::nullopt;
+  if (map_.empty()) return StartupWait{StartupCondition::kNoBeaconMap, 0.0, 0.0, {}};
+  if (!timeline_.last_stamp_ns()) return StartupWait{StartupCondition::kNoOdometry, 0.0, 0.0, {}};
+  if (heard_by_all_ < kMinTxs) {
+    return StartupWait{StartupCondition::kTooFewBeacons, static_cast<double>(heard_by_all_),
+                       static_cast<double>(kMinTxs), "heard by all three receivers"};
+  }
+  return StartupWait{StartupCondition::kFixFailed, 0.0, 0.0, "uhl: " + uhl_failure_};
 }
 
 PoseStatus UhlLast2::status() const {

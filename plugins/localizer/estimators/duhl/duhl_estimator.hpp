@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 
+#include "beaconloc/core/chi_square.hpp"
 #include "beaconloc/core/estimator.hpp"
 #include "beaconloc/core/filters/ekf.hpp"
 #include "beaconloc/core/odometry_timeline.hpp"
@@ -14,12 +15,15 @@
 
 namespace beaconloc::duhl {
 
+// The UHL needs the distances of at least two Txs (Sec. II-B).
+inline constexpr std::size_t kMinTxs = 2;
+
 struct DuhlParameters {
   UhlOptions uhl;
   // Eq. 31-32: a Tx whose largest distance variance exceeds this is discarded. The paper sets it
   // experimentally without printing it; (3 cm)^2 is our choice, three times sigma_dd.
   double discard_variance_m2 = 0.03 * 0.03;
-  double observation_nis_gate = 16.27;  // chi-square, 3 dof, 99.9 %
+  double observation_nis_gate = kChiSquare999ThreeDof;
   // UHL poses refused in a row (2 s at 5 Hz) before the filter restarts from the UHL; 0: never.
   // Not in the paper: a robot that lost track must find it again. Measured with
   // `beaconloc accuracy` on trajectory 4, seeds 1-20: without it seed 19 stayed lost (E_p RMS
@@ -38,7 +42,7 @@ struct DuhlParameters {
   // A measured distance whose squared innovation against its prediction q_l exceeds this many
   // variances (chi-square, 1 dof, 99.9 %) discards the Tx's estimate, which is then initialized
   // anew from the pose (eq. 28-29) and corrected with the measurement; 0: never. Not in the paper.
-  double distance_innovation_gate = 10.83;
+  double distance_innovation_gate = kChiSquare999OneDof;
 
   static DuhlParameters from(const EstimatorConfig& config);
 };
@@ -53,6 +57,7 @@ class Duhl final : public Estimator {
   InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
+  std::optional<StartupWait> startup_wait() const override;
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<Duhl>(*this); }
   std::size_t available_txs() const { return available_.size(); }
   // Tx estimates discarded because their own measurement contradicted them (distance_innovation_gate).
@@ -82,6 +87,7 @@ class Duhl final : public Estimator {
   StampNs last_correction_stamp_ns_ = 0;
   int consecutive_gated_ = 0;
   std::uint64_t contradicted_txs_ = 0;
+  std::string uhl_failure_;  // why the last UHL solve failed
 };
 
 // The paper's baseline: UHL on the distances last measured from the last two Txs, no odometry.
@@ -94,9 +100,11 @@ class UhlLast2 final : public Estimator {
   InputResult update(const RangeMeasurement& range) override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
+  std::optional<StartupWait> startup_wait() const override;
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<UhlLast2>(*this); }
 
  private:
+  static UhlOptions options_from(const EstimatorConfig& config);
   struct Firing {
     std::uint32_t beacon_id;
     Distances d;
@@ -112,6 +120,8 @@ class UhlLast2 final : public Estimator {
   bool pending_ = false;
   std::optional<PoseEstimate> last_;
   StampNs last_solution_stamp_ns_ = 0;
+  std::size_t heard_by_all_ = 0;  // of the last Txs, those heard by all three receivers (at most kMinTxs)
+  std::string uhl_failure_;       // why the last UHL solve failed
 };
 
 // R of eq. 21: sum over the Txs of J_z,q^i Q^i J_z,q^i^T, J_z,q^i the UHL's Jacobian at the

@@ -1,10 +1,13 @@
 #include "range_ekf.hpp"
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
+#include "beaconloc/core/chi_square.hpp"
+#include "beaconloc/core/estimator_parameters.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "beaconloc/core/models/range_model.hpp"
@@ -16,30 +19,47 @@ namespace {
 // Arrivals of one firing at the receivers of one robot: within the time sound takes to cross the
 // robot (0.4 m / 343 m/s = 1.2 ms), far less than the 200 ms between two firings.
 constexpr StampNs kSameFiringNs = 20 * kNsPerMillisecond;
+// One pose is preferred to another (a global fix to its mirror image, a fix to a suspect
+// filter pose) when it fits the same ranges better by this much weighted squared residual.
+// Whichever of two poses is the robot's, noise makes the other fit better by T with probability
+// at most Phi(-sqrt(T)) (the cost difference is N(-d^2, 4 d^2) for predictions d sigma apart;
+// worst at d^2 = T): 0.05 % at chi-square 1 dof 99.9 %.
+constexpr double kPoseMarginChiSquare = kChiSquare999OneDof;
 }  // namespace
 
 RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
+  namespace ranges = parameter_ranges;
+  ParameterReader in(c, "range_ekf");
   RangeEkfParameters p;
-  p.nis_gate = c.parameter("nis_gate", p.nis_gate);
-  p.init_window_s = c.parameter("init_window_s", p.init_window_s);
-  p.init_min_beacons = static_cast<int>(c.parameter("init_min_beacons", p.init_min_beacons));
-  p.init_min_ranges = static_cast<int>(c.parameter("init_min_ranges", p.init_min_ranges));
-  p.init_min_beacon_spread_m = c.parameter("init_min_beacon_spread_m", p.init_min_beacon_spread_m);
-  p.max_odometry_gap_s = c.parameter("max_odometry_gap_s", p.max_odometry_gap_s);
-  p.reinitialize_after_gated =
-      static_cast<int>(c.parameter("reinitialize_after_gated", p.reinitialize_after_gated));
-  p.max_range_age_s = c.parameter("max_range_age_s", p.max_range_age_s);
-  p.init_max_position_sigma_m = c.parameter("init_max_position_sigma_m", p.init_max_position_sigma_m);
-  p.init_max_yaw_sigma_rad = c.parameter("init_max_yaw_sigma_rad", p.init_max_yaw_sigma_rad);
-  p.init_retry_interval_s = c.parameter("init_retry_interval_s", p.init_retry_interval_s);
-  p.init_outlier_gate_sigma = c.parameter("init_outlier_gate_sigma", p.init_outlier_gate_sigma);
+  p.nis_gate = in.real("nis_gate", p.nis_gate, ranges::kChiSquareGate);
+  p.init_window_s = in.real("init_window_s", p.init_window_s, ParameterRange::above(0.0, 60.0));
+  p.init_min_beacons = in.count("init_min_beacons", p.init_min_beacons, 1, 100);
+  p.init_min_ranges =
+      in.count("init_min_ranges", p.init_min_ranges, static_cast<int>(kRangePoseMinObservations), 1000);
+  p.max_odometry_gap_s = in.real("max_odometry_gap_s", p.max_odometry_gap_s, ranges::kDataDurationS);
+  p.reinitialize_after_gated = in.count("reinitialize_after_gated", p.reinitialize_after_gated, 1, 1000);
+  p.max_range_age_s = in.real("max_range_age_s", p.max_range_age_s, ranges::kDataDurationS);
+  p.init_max_position_sigma_m =
+      in.real("init_max_position_sigma_m", p.init_max_position_sigma_m, ranges::kPositionSigmaM);
+  p.init_max_yaw_sigma_rad =
+      in.real("init_max_yaw_sigma_rad", p.init_max_yaw_sigma_rad, ranges::kHeadingSigmaRad);
+  p.init_retry_interval_s = in.real("init_retry_interval_s", p.init_retry_interval_s,
+                                    ParameterRange::closed(0.0, ranges::kDataDurationS.max));
+  p.init_outlier_gate_sigma =
+      in.real("init_outlier_gate_sigma", p.init_outlier_gate_sigma, ParameterRange::closed(0.0, 100.0));
+  p.divergence_window_ranges = in.count("divergence_window_ranges", p.divergence_window_ranges, 1, 1000);
+  p.divergence_gated_ranges =
+      in.count("divergence_gated_ranges", p.divergence_gated_ranges, 1, p.divergence_window_ranges);
+  in.finish();
   return p;
 }
 
 RangeEkf::RangeEkf(const EstimatorConfig& config)
     : receivers_(config.receivers),
       params_(RangeEkfParameters::from(config)),
-      timeline_(params_.max_odometry_gap_s) {}
+      timeline_(params_.max_odometry_gap_s) {
+  waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(params_.init_min_beacons), {}};
+}
 
 InputResult RangeEkf::predict(const OdometrySample& o) {
   const OdometryTimeline::Step step = timeline_.advance(o);
@@ -93,13 +113,16 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r) {
       ekf_.mutable_state().z() = wrap_angle_rad(ekf_.state().z());
       consecutive_gated_ = 0;
       last_correction_stamp_ns_ = std::max(r.stamp_ns, timeline_.last_stamp_ns().value_or(r.stamp_ns));
+      watch_divergence({false, result.nis});
       return InputResult::ok();
     case UpdateOutcome::kSingularInnovation:
       return InputResult::rejected("singular_innovation");
     case UpdateOutcome::kGated:
       break;
   }
-  if (++consecutive_gated_ >= params_.reinitialize_after_gated) {
+  ++consecutive_gated_;
+  watch_divergence({true, result.nis});
+  if (initialized_ && consecutive_gated_ >= params_.reinitialize_after_gated) {
     // The filter no longer agrees with the beacons: start again from a global fix.
     initialized_ = false;
     consecutive_gated_ = 0;
@@ -108,26 +131,86 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r) {
   return InputResult::rejected("gated_nis");
 }
 
-void RangeEkf::try_initialize() {
-  // The multi-start solve costs ~1 ms: not more often than init_retry_interval_s of data time.
-  const StampNs now_ns = window_.back().range.stamp_ns;
-  if (last_init_attempt_ns_ && now_ns - *last_init_attempt_ns_ < s_to_ns(params_.init_retry_interval_s))
-    return;
-  std::set<std::uint32_t> beacons;
-  for (const auto& b : window_) beacons.insert(b.range.beacon_id);
-  if (static_cast<int>(beacons.size()) < params_.init_min_beacons) return;
-  // Spread of the beacons across their principal axis (smallest eigenvalue of their scatter).
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (auto id : beacons) mean += map_.find(id)->position_map_m.head<2>();
-  mean /= static_cast<double>(beacons.size());
-  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-  for (auto id : beacons) {
-    const Eigen::Vector2d d = map_.find(id)->position_map_m.head<2>() - mean;
-    scatter += d * d.transpose() / static_cast<double>(beacons.size());
+// The recent ranges judge the pose: a run of gated ranges, or applied ones fitting worse than
+// chi-square allows, make it suspect (degraded); a global fix from the window of ranges settles
+// it, restarting the filter when the fix contradicts it.
+void RangeEkf::watch_divergence(const RangeOutcome& outcome) {
+  recent_.push_back(outcome);
+  while (static_cast<int>(recent_.size()) > params_.divergence_window_ranges) recent_.pop_front();
+  int gated = 0, applied = 0;
+  double applied_nis = 0.0;
+  for (const RangeOutcome& o : recent_) {
+    if (o.gated) {
+      ++gated;
+    } else {
+      ++applied;
+      applied_nis += o.nis;
+    }
   }
-  if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter).eigenvalues().minCoeff() <
-      params_.init_min_beacon_spread_m * params_.init_min_beacon_spread_m) {
+  const bool full = static_cast<int>(recent_.size()) == params_.divergence_window_ranges;
+  suspect_ = gated >= params_.divergence_gated_ranges ||
+             (full && applied > 0 && applied_nis > chi_square_quantile_999(applied));
+  if (!suspect_) return;
+  const StampNs now_ns = window_.back().range.stamp_ns;
+  if (!attempt_due(now_ns)) return;
+  const WindowFix fix = window_fix();
+  if (fix.solved) last_init_attempt_ns_ = now_ns;
+  if (!fix.ok) return;  // nothing to settle it with yet: the pose stays degraded
+  // Contradicted: the fix lies outside the pose's uncertainty and explains the window's ranges
+  // better by the margin (echoes capped, so that they weigh on both alike).
+  const Eigen::Vector3d d = pose_difference(fix.pose, ekf_.state());
+  const double cap_sigma = params_.init_outlier_gate_sigma > 0.0 ? params_.init_outlier_gate_sigma
+                                                                 : std::numeric_limits<double>::infinity();
+  const double fix_cost = truncated_range_cost(fix.observations, fix.pose, cap_sigma);
+  const double pose_cost = truncated_range_cost(fix.observations, ekf_.state(), cap_sigma);
+  const double margin = kPoseMarginChiSquare * fix.variance_factor;
+  if (d.dot((ekf_.covariance() + fix.covariance).ldlt().solve(d)) > kChiSquare999ThreeDof &&
+      pose_cost - fix_cost > margin) {
+    start_from(fix.pose, fix.covariance, std::max(now_ns, timeline_.last_stamp_ns().value_or(now_ns)));
+    ++divergence_reinitializations_;
+  }
+  recent_.clear();  // explained: by a wrong pose now replaced, or by outliers the fix agrees on
+  suspect_ = false;
+}
+
+bool RangeEkf::attempt_due(StampNs now_ns) const {
+  // The multi-start solve costs ~1 ms: not more often than init_retry_interval_s of data time.
+  return !last_init_attempt_ns_ || now_ns - *last_init_attempt_ns_ >= s_to_ns(params_.init_retry_interval_s);
+}
+
+void RangeEkf::try_initialize() {
+  const StampNs now_ns = window_.back().range.stamp_ns;
+  if (!attempt_due(now_ns)) return;
+  const WindowFix fix = window_fix();
+  if (fix.solved) last_init_attempt_ns_ = now_ns;
+  if (!fix.ok) {
+    waiting_for_ = fix.why_not;
     return;
+  }
+  start_from(fix.pose, fix.covariance, std::max(now_ns, timeline_.last_stamp_ns().value_or(now_ns)));
+}
+
+void RangeEkf::start_from(const Pose2& pose, const Cov3& covariance, StampNs correction_stamp_ns) {
+  ekf_.reset(pose, covariance);
+  initialized_ = true;
+  consecutive_gated_ = 0;
+  recent_.clear();
+  suspect_ = false;
+  last_correction_stamp_ns_ = correction_stamp_ns;
+}
+
+RangeEkf::WindowFix RangeEkf::window_fix() const {
+  WindowFix out;
+  std::set<std::uint32_t> beacons;
+  for (const auto& b : window_) {
+    if (map_.find(b.range.beacon_id)) beacons.insert(b.range.beacon_id);
+  }
+  if (static_cast<int>(beacons.size()) < params_.init_min_beacons) {
+    out.why_not = {StartupCondition::kTooFewBeacons,
+                   static_cast<double>(beacons.size()),
+                   static_cast<double>(params_.init_min_beacons),
+                   {}};
+    return out;
   }
   // Echoes, screened by geometry alone: two receivers d apart hearing one firing measure ranges
   // that differ by at most d (triangle inequality); an echo's path is longer, so of a pair that
@@ -151,49 +234,75 @@ void RangeEkf::try_initialize() {
 
   std::vector<RangeObservation> observations;
   for (std::size_t k = 0; k < window_.size(); ++k) {
-    if (echo[k]) continue;
     const BufferedRange& b = window_[k];
+    const Beacon* beacon = map_.find(b.range.beacon_id);
+    if (echo[k] || !beacon) continue;
     // Where the receiver was, in the frame of the robot now (dead-reckoned odometry).
     const Pose2 then_in_now = between(odom_pose_, b.odom_pose_at_range);
     const double travelled_m = then_in_now.head<2>().norm();
     RangeObservation o;
     o.receiver_solve_frame_m = transform_point(then_in_now, receivers_.receivers_base_m[b.range.receiver_id]);
     o.receiver_z_m = receivers_.receiver_height_m;
-    o.beacon_map_m = map_.find(b.range.beacon_id)->position_map_m;
+    o.beacon_map_m = beacon->position_map_m;
     o.range_m = b.range.range_m;
     // Odometry drift over the window adds to the range noise: 2 % of the distance travelled.
     o.variance_m2 = b.range.variance_m2 + std::pow(0.02 * travelled_m, 2);
     observations.push_back(o);
   }
+  // Three unknowns: with fewer than init_min_ranges ranges an echo among them fits as well as the
+  // truth does; wait for redundancy.
+  if (static_cast<int>(observations.size()) < params_.init_min_ranges) {
+    out.why_not = {StartupCondition::kTooFewRanges,
+                   static_cast<double>(observations.size()),
+                   static_cast<double>(params_.init_min_ranges),
+                   {}};
+    return out;
+  }
   // Echoes (a reflection's longer path) in the window would pull the fix off the pose: drop the
   // ranges the fix cannot explain (core/solvers/range_pose_solver.hpp).
   RangePoseSolverOptions solver;
   solver.outlier_gate_sigma = params_.init_outlier_gate_sigma;
-  // Three unknowns: with fewer than init_min_ranges ranges an echo among them fits as well as the
-  // truth does; wait for redundancy.
-  if (static_cast<int>(observations.size()) < params_.init_min_ranges) return;
-  last_init_attempt_ns_ = now_ns;
+  out.solved = true;
   const RangePoseSolution fix = solve_pose_from_ranges(observations, solver);
-  if (!fix.ok) return;
-  if (std::sqrt(fix.covariance(0, 0) + fix.covariance(1, 1)) > params_.init_max_position_sigma_m ||
-      std::sqrt(fix.covariance(2, 2)) > params_.init_max_yaw_sigma_rad) {
-    return;  // geometry too weak yet; wait for more beacons
+  if (!fix.ok) {
+    out.why_not = {StartupCondition::kFixFailed, 0.0, 0.0, fix.failure};
+    return out;
   }
+  // The ranges moved by odometry fit worse than their noise says when the window's motion
+  // drifted (a fast turn): cost differences are then as much larger, and so is the margin.
+  const double dof = static_cast<double>(observations.size() - fix.outliers) - 3.0;
+  out.variance_factor = std::max(1.0, fix.weighted_residual_rms * fix.weighted_residual_rms *
+                                          static_cast<double>(observations.size() - fix.outliers) / dof);
+  if (fix.mirror_cost_margin < kPoseMarginChiSquare * out.variance_factor) {
+    // Beacons on one line, and receivers that cannot tell its two sides apart.
+    out.why_not = {StartupCondition::kMirrorAmbiguous,
+                   fix.mirror_cost_margin,
+                   kPoseMarginChiSquare * out.variance_factor,
+                   {}};
+    return out;
+  }
+  const double position_sigma_m = std::sqrt(fix.covariance(0, 0) + fix.covariance(1, 1));
+  if (position_sigma_m > params_.init_max_position_sigma_m) {  // geometry too weak yet
+    out.why_not = {
+        StartupCondition::kPositionTooUncertain, position_sigma_m, params_.init_max_position_sigma_m, {}};
+    return out;
+  }
+  const double yaw_sigma_rad = std::sqrt(fix.covariance(2, 2));
+  if (yaw_sigma_rad > params_.init_max_yaw_sigma_rad) {
+    out.why_not = {StartupCondition::kHeadingTooUncertain, yaw_sigma_rad, params_.init_max_yaw_sigma_rad, {}};
+    return out;
+  }
+  out.ok = true;
+  out.pose = fix.pose;
+  out.observations = std::move(observations);
   // The fix ignores the correlation the shared odometry introduces: inflate it.
-  const Cov3 p0 = 4.0 * fix.covariance + Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal().toDenseMatrix();
-  ekf_.reset(fix.pose, p0);
-  initialized_ = true;
-  consecutive_gated_ = 0;
-  last_correction_stamp_ns_ = std::max(window_.back().range.stamp_ns,
-                                       timeline_.last_stamp_ns().value_or(window_.back().range.stamp_ns));
+  out.covariance = 4.0 * fix.covariance + Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal().toDenseMatrix();
+  return out;
 }
 
 InputResult RangeEkf::reset(StampNs stamp_ns, const Pose2& pose, const Cov3& covariance) {
   if (const InputResult checked = check_initial_pose(pose, covariance); !checked.accepted) return checked;
-  ekf_.reset(pose, covariance);  // the global fix is not needed: the pose was given
-  initialized_ = true;
-  consecutive_gated_ = 0;
-  last_correction_stamp_ns_ = timeline_.last_stamp_ns().value_or(stamp_ns);
+  start_from(pose, covariance, timeline_.last_stamp_ns().value_or(stamp_ns));  // no global fix needed
   return InputResult::ok();
 }
 
@@ -209,8 +318,16 @@ std::optional<PoseEstimate> RangeEkf::estimate() const {
 
 PoseStatus RangeEkf::status() const {
   if (!initialized_) return PoseStatus::kInitializing;
-  return staleness_.classify(timeline_.last_stamp_ns().value_or(last_correction_stamp_ns_),
-                             last_correction_stamp_ns_);
+  const PoseStatus s = staleness_.classify(timeline_.last_stamp_ns().value_or(last_correction_stamp_ns_),
+                                           last_correction_stamp_ns_);
+  return suspect_ && s == PoseStatus::kOk ? PoseStatus::kDegraded : s;
+}
+
+std::optional<StartupWait> RangeEkf::startup_wait() const {
+  if (estimate()) return std::nullopt;
+  if (map_.empty()) return StartupWait{StartupCondition::kNoBeaconMap, 0.0, 0.0, {}};
+  if (initialized_) return StartupWait{StartupCondition::kNoOdometry, 0.0, 0.0, {}};
+  return waiting_for_;
 }
 
 namespace {

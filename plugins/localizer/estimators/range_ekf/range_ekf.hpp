@@ -1,26 +1,26 @@
 #pragma once
 // range_ekf: EKF on [x, y, yaw], predicted by wheel odometry (seed 000 eq. 14, 16) and updated
 // by each range on its own (3D range from a receiver to a ceiling beacon of known height), with
-// NIS gating. Initialized, and re-initialized after a run of gated ranges, by a global
-// range-only fix (core/solvers/range_pose_solver) over a window of ranges, each moved to the
-// current pose through the dead-reckoned odometry.
+// NIS gating. Initialized by a global range-only fix (core/solvers/range_pose_solver) over a
+// window of ranges, each moved to the current pose through the dead-reckoned odometry, once the
+// fix is unambiguous and certain enough. Watched for divergence over the recent ranges: a pose
+// they contradict is degraded and, when a global fix confirms it is wrong, re-initialized.
 #include <deque>
 #include <optional>
 
+#include "beaconloc/core/chi_square.hpp"
 #include "beaconloc/core/estimator.hpp"
 #include "beaconloc/core/filters/ekf.hpp"
 #include "beaconloc/core/odometry_timeline.hpp"
+#include "beaconloc/core/solvers/range_pose_solver.hpp"
 
 namespace beaconloc {
 
 struct RangeEkfParameters {
-  double nis_gate = 10.83;     // chi-square, 1 dof, 99.9 %
+  double nis_gate = kChiSquare999OneDof;
   double init_window_s = 3.0;  // ranges kept for a global fix
   int init_min_beacons = 3;
   int init_min_ranges = 8;  // ranges (after the echo screen) a global fix needs: 3 unknowns + 5
-  // Beacons all on one line leave the mirror image of the pose as good a fit: a global fix
-  // waits until the beacons heard spread this far across their principal axis (RMS).
-  double init_min_beacon_spread_m = 0.2;
   double init_max_position_sigma_m = 0.3;
   double init_max_yaw_sigma_rad = 0.35;
   double max_odometry_gap_s = 0.2;  // a longer gap is not integrated (reason odometry_gap)
@@ -31,6 +31,15 @@ struct RangeEkfParameters {
   // A range of the window more than this many sigma off the global fix is dropped as an echo
   // (up to 40 % of them); 0 keeps every range.
   double init_outlier_gate_sigma = 4.0;
+  // Divergence: over the last divergence_window_ranges ranges fused or gated, the pose is
+  // suspect when divergence_gated_ranges of them were gated, or when the NIS of those applied
+  // sums above chi-square 99.9 % for their count. A suspect pose is degraded until a global fix
+  // from the window either agrees with it (the gated ranges were outliers) or contradicts it
+  // (the filter is re-initialized from the fix). A good pose gates 0.1 % of good ranges
+  // (nis_gate) and 3-6 % of all under 30 % echoes (the decoder refuses most): 6 of 20 then has a
+  // chance of 3e-4 (at 5 %) per window, while a pose metres off meets it within 6-9 ranges.
+  int divergence_window_ranges = 20;
+  int divergence_gated_ranges = 6;
 
   static RangeEkfParameters from(const EstimatorConfig& config);
 };
@@ -45,15 +54,37 @@ class RangeEkf final : public Estimator {
   InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
+  std::optional<StartupWait> startup_wait() const override;
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<RangeEkf>(*this); }
+  // Re-initializations from a global fix that contradicted a suspect pose.
+  std::uint64_t divergence_reinitializations() const { return divergence_reinitializations_; }
 
  private:
   struct BufferedRange {
     RangeMeasurement range;
     Pose2 odom_pose_at_range;
   };
+  // The global fix from the window of ranges (covariance inflated for the shared odometry), or
+  // the start-up condition it does not meet. solved: the solver ran (the costly part).
+  struct WindowFix {
+    bool ok = false;
+    bool solved = false;
+    Pose2 pose = Pose2::Zero();
+    Cov3 covariance = Cov3::Identity();
+    StartupWait why_not;
+    std::vector<RangeObservation> observations;  // the window's ranges after the echo screen
+    double variance_factor = 1.0;                // the fix's cost per degree of freedom, when above 1
+  };
+  struct RangeOutcome {
+    bool gated;
+    double nis;
+  };
   InputResult fuse(const RangeMeasurement& range);
+  WindowFix window_fix() const;
+  bool attempt_due(StampNs now_ns) const;
   void try_initialize();
+  void watch_divergence(const RangeOutcome& outcome);
+  void start_from(const Pose2& pose, const Cov3& covariance, StampNs stamp_ns);
 
   ReceiverArray receivers_;
   RangeEkfParameters params_;
@@ -67,6 +98,10 @@ class RangeEkf final : public Estimator {
   std::deque<BufferedRange> window_;
   int consecutive_gated_ = 0;
   std::optional<StampNs> last_init_attempt_ns_;
+  StartupWait waiting_for_;          // why the last attempt at a global fix gave no pose
+  std::deque<RangeOutcome> recent_;  // the last divergence_window_ranges fused or gated
+  bool suspect_ = false;             // the recent ranges contradict the pose; no fix settled it yet
+  std::uint64_t divergence_reinitializations_ = 0;
 };
 
 }  // namespace beaconloc

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "beaconloc/core/estimator_parameters.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/filters/symmetric.hpp"
 #include "beaconloc/core/models/range_model.hpp"
@@ -15,56 +16,63 @@ namespace {
 constexpr int kPose = 3;
 constexpr int kMotionNoise = 2;  // eq. 8: n_u on (v, omega)
 
+std::string mode_name(Mode mode) {
+  switch (mode) {
+    case Mode::kFusion:
+      return "ukf_lrf";
+    case Mode::kLaserOnly:
+      return "ukf_lrf_laser_only";
+    case Mode::kBeaconsOnly:
+      return "ukf_lrf_beacons_only";
+  }
+  return "ukf_lrf";
+}
+
 bool usable_beam(float range_m, const LaserScanSample& scan) {
   return std::isfinite(range_m) && range_m > scan.range_min_m && range_m < scan.range_max_m;
 }
 
 }  // namespace
 
-UkfLrfParameters UkfLrfParameters::from(const EstimatorConfig& c) {
+UkfLrfParameters UkfLrfParameters::from(const EstimatorConfig& c, const std::string& estimator) {
+  namespace ranges = parameter_ranges;
+  ParameterReader in(c, estimator);
   UkfLrfParameters p;
-  p.unscented.alpha = c.parameter("ut_alpha", p.unscented.alpha);
-  p.unscented.beta = c.parameter("ut_beta", p.unscented.beta);
-  p.unscented.kappa = c.parameter("ut_kappa", p.unscented.kappa);
-  for (int i = 0; i < 4; ++i) p.alpha[i] = c.parameter("alpha" + std::to_string(i + 1), p.alpha[i]);
-  p.beacon_sigma_m = c.parameter("beacon_sigma_m", p.beacon_sigma_m);
-  p.laser_sigma_m = c.parameter("laser_sigma_m", p.laser_sigma_m);
-  p.initial_pose = c.initial_pose;
-  p.initial_sigma_xy_m = c.parameter("initial_sigma_xy_m", p.initial_sigma_xy_m);
-  p.initial_sigma_yaw_rad = c.parameter("initial_sigma_yaw_rad", p.initial_sigma_yaw_rad);
-  p.laser_mount_base = Pose2(c.parameter("laser_mount_x_m", 0.0), c.parameter("laser_mount_y_m", 0.0),
-                             c.parameter("laser_mount_yaw_rad", 0.0));
-  p.max_odometry_gap_s = c.parameter("max_odometry_gap_s", p.max_odometry_gap_s);
-  p.max_beams = static_cast<int>(c.parameter("max_beams", p.max_beams));
-  p.max_measurement_age_s = c.parameter("max_measurement_age_s", p.max_measurement_age_s);
-  // Refused here, at start, not at the first step.
-  auto require = [](bool ok, const char* what) {
-    if (!ok) throw std::invalid_argument(std::string("ukf_lrf: ") + what);
-  };
-  require(p.unscented.alpha > 0.0 && std::isfinite(p.unscented.beta) && std::isfinite(p.unscented.kappa),
-          "ut_alpha must be positive and ut_beta, ut_kappa finite");
-  try {
-    UnscentedWeights(kPose + 1, p.unscented);  // the smallest augmented state: a pose and one range
-  } catch (const std::invalid_argument&) {
-    require(false, "ut_alpha and ut_kappa give L + lambda <= 0");
+  // Eq. 14: alpha in (0, 1] spreads the sigma points; beta >= 0 weighs the centre point's
+  // covariance (2 for a Gaussian); L + lambda = alpha^2 (L + kappa) > 0 for every augmented size
+  // L >= kPose + 1 (a pose and one range) needs kappa > -(kPose + 1).
+  p.unscented.alpha = in.real("ut_alpha", p.unscented.alpha, ParameterRange::above(0.0, 1.0));
+  p.unscented.beta = in.real("ut_beta", p.unscented.beta, ParameterRange::closed(0.0, 10.0));
+  p.unscented.kappa = in.real("ut_kappa", p.unscented.kappa, ParameterRange::above(-(kPose + 1.0), 100.0));
+  // Eq. 6: variances of the velocity noise per squared velocity; 1 is a noise as large as the motion.
+  for (int i = 0; i < 4; ++i) {
+    p.alpha[i] = in.real("alpha" + std::to_string(i + 1), p.alpha[i], ParameterRange::closed(0.0, 1.0));
   }
-  for (double a : p.alpha) require(a >= 0.0 && std::isfinite(a), "alpha1..alpha4 must be finite and >= 0");
-  require(p.beacon_sigma_m > 0.0 && std::isfinite(p.beacon_sigma_m) && p.laser_sigma_m > 0.0 &&
-              std::isfinite(p.laser_sigma_m),
-          "beacon_sigma_m and laser_sigma_m must be positive");
-  require(p.initial_sigma_xy_m > 0.0 && p.initial_sigma_yaw_rad > 0.0 &&
-              std::isfinite(p.initial_sigma_xy_m) && std::isfinite(p.initial_sigma_yaw_rad),
-          "initial_sigma_xy_m and initial_sigma_yaw_rad must be positive");
-  require(p.laser_mount_base.allFinite(), "the laser mount must be finite");
-  require(p.max_odometry_gap_s > 0.0 && p.max_measurement_age_s > 0.0, "time limits must be positive");
-  require(p.max_beams >= 1, "max_beams must be at least 1");
-  require(!p.initial_pose || p.initial_pose->allFinite(), "the initial pose must be finite");
+  p.beacon_sigma_m = in.real("beacon_sigma_m", p.beacon_sigma_m, ParameterRange::above(0.0, 10.0));
+  p.laser_sigma_m = in.real("laser_sigma_m", p.laser_sigma_m, ParameterRange::above(0.0, 10.0));
+  p.initial_pose = c.initial_pose;
+  p.initial_sigma_xy_m = in.real("initial_sigma_xy_m", p.initial_sigma_xy_m, ranges::kPositionSigmaM);
+  p.initial_sigma_yaw_rad =
+      in.real("initial_sigma_yaw_rad", p.initial_sigma_yaw_rad, ranges::kHeadingSigmaRad);
+  // Where the scanner sits on the robot: within 5 m of its origin.
+  const ParameterRange mount_m = ParameterRange::closed(-5.0, 5.0);
+  p.laser_mount_base =
+      Pose2(in.real("laser_mount_x_m", 0.0, mount_m), in.real("laser_mount_y_m", 0.0, mount_m),
+            in.real("laser_mount_yaw_rad", 0.0, ParameterRange::closed(-M_PI, M_PI)));
+  p.max_odometry_gap_s = in.real("max_odometry_gap_s", p.max_odometry_gap_s, ranges::kDataDurationS);
+  // N_W: the augmented state grows by one per beam (a 1000-beam state is a 1000 x 1000 Cholesky a scan).
+  p.max_beams = in.count("max_beams", p.max_beams, 1, 1000);
+  p.max_measurement_age_s = in.real("max_measurement_age_s", p.max_measurement_age_s, ranges::kDataDurationS);
+  in.finish();
+  if (p.initial_pose && !p.initial_pose->allFinite()) {
+    throw std::invalid_argument(estimator + ": the initial pose must be finite");
+  }
   return p;
 }
 
 UkfLrf::UkfLrf(const EstimatorConfig& config, Mode mode)
     : mode_(mode),
-      params_(UkfLrfParameters::from(config)),
+      params_(UkfLrfParameters::from(config, mode_name(mode))),
       grid_(config.occupancy_grid),
       timeline_(params_.max_odometry_gap_s) {
   if (mode_ != Mode::kBeaconsOnly && !grid_) {
@@ -87,17 +95,7 @@ UkfLrf::UkfLrf(const EstimatorConfig& config, Mode mode)
   }
 }
 
-std::string UkfLrf::name() const {
-  switch (mode_) {
-    case Mode::kFusion:
-      return "ukf_lrf";
-    case Mode::kLaserOnly:
-      return "ukf_lrf_laser_only";
-    case Mode::kBeaconsOnly:
-      return "ukf_lrf_beacons_only";
-  }
-  return "ukf_lrf";
-}
+std::string UkfLrf::name() const { return mode_name(mode_); }
 
 InputResult UkfLrf::update(const RangeMeasurement& r) {
   if (mode_ == Mode::kLaserOnly) return InputResult::rejected("beacons_unused");
@@ -351,6 +349,12 @@ InputResult UkfLrf::reset(StampNs stamp_ns, const Pose2& pose, const Cov3& covar
 std::optional<PoseEstimate> UkfLrf::estimate() const {
   if (!initialized_ || !timeline_.last_stamp_ns()) return std::nullopt;
   return PoseEstimate{*timeline_.last_stamp_ns(), mean_, covariance_, status()};
+}
+
+std::optional<StartupWait> UkfLrf::startup_wait() const {
+  if (estimate()) return std::nullopt;
+  if (!initialized_) return StartupWait{StartupCondition::kNeedsInitialPose, 0.0, 0.0, {}};
+  return StartupWait{StartupCondition::kNoOdometry, 0.0, 0.0, {}};
 }
 
 PoseStatus UkfLrf::status() const {

@@ -37,7 +37,8 @@ struct UkfLrfParameters {
   int max_beams = 19;                  // N_W of Sec. 3.4: longer scans are thinned evenly
   double max_measurement_age_s = 0.1;  // a range or scan older than this behind the filter is stale
 
-  static UkfLrfParameters from(const EstimatorConfig& config);
+  // estimator: the mode's registered name, for the messages.
+  static UkfLrfParameters from(const EstimatorConfig& config, const std::string& estimator);
 };
 
 class UkfLrf final : public Estimator {
@@ -56,6 +57,7 @@ class UkfLrf final : public Estimator {
   InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
   std::optional<PoseEstimate> estimate() const override;
   PoseStatus status() const override;
+  std::optional<StartupWait> startup_wait() const override;
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<UkfLrf>(*this); }
 
  private:

@@ -41,22 +41,44 @@ struct InputResult {
 
 struct EstimatorConfig {
   ReceiverArray receivers;
-  std::map<std::string, double> parameters;  // estimator-specific, documented by each plugin
+  // Estimator-specific, read and checked by each plugin (core/estimator_parameters.hpp).
+  std::map<std::string, double> parameters;
   // The occupancy grid of the map, for estimators with a laser model; null when none was given.
   std::shared_ptr<const OccupancyGrid> occupancy_grid;
   // Where the robot starts, for estimators placed by hand (seed 001 Sec. 4.1); others ignore it.
   std::optional<Pose2> initial_pose;
-
-  double parameter(const std::string& name, double fallback) const {
-    auto it = parameters.find(name);
-    return it == parameters.end() ? fallback : it->second;
-  }
 };
 
 // NAME=VALUE items (the --param options) as estimator parameters. Throws std::invalid_argument
-// naming the option and the item that is not NAME=VALUE or whose value is not a finite number.
+// naming the option and the item that is not NAME=VALUE, whose value is not a finite number, or
+// whose name an earlier item gave already. Whether the estimator knows the name and the value is
+// in its range is the estimator's check (core/estimator_parameters.hpp).
 std::map<std::string, double> parse_estimator_parameters(const std::vector<std::string>& items,
                                                          const std::string& option_name);
+
+// Why an estimator has no pose yet: the start-up condition it waits for. Stable snake_case names
+// (to_string), counted per robot in the localizer's Diagnostics.
+enum class StartupCondition {
+  kNoBeaconMap,           // no beacon map yet
+  kNoOdometry,            // no odometry sample yet (a pose is stamped by the odometry)
+  kNeedsInitialPose,      // placed by hand: --initial-pose or an initial_pose message
+  kTooFewBeacons,         // value of limit beacons heard
+  kTooFewRanges,          // value of limit usable ranges (after the echo screen)
+  kFixFailed,             // the global fix found no pose (note: the solver's reason)
+  kMirrorAmbiguous,       // beacons on one line: the mirror image fits as well (value: its chi-square margin)
+  kPositionTooUncertain,  // the fix's position sigma (value, m) above the limit
+  kHeadingTooUncertain,   // the fix's heading sigma (value, rad) above the limit
+};
+const char* to_string(StartupCondition c);
+
+struct StartupWait {
+  StartupCondition condition = StartupCondition::kNoBeaconMap;
+  double value = 0.0;  // the number that matters (see StartupCondition), and the limit it must reach
+  double limit = 0.0;
+  std::string note;  // for people only (e.g. the solver's failure); never decided on
+  // "2 of 3 beacons heard", "fix too uncertain: position sigma 0.52 m > 0.30 m", ...
+  std::string describe() const;
+};
 
 class Estimator {
  public:
@@ -97,6 +119,9 @@ class Estimator {
   virtual std::optional<PoseEstimate> estimate() const = 0;
   // Status from data time alone (the stamps pushed so far).
   virtual PoseStatus status() const = 0;
+  // While estimate() is nullopt, the start-up condition the estimator waits for; nullopt once
+  // it has a pose.
+  virtual std::optional<StartupWait> startup_wait() const = 0;
   // A copy of the whole state, to roll back to when a measurement arrives late
   // (core/out_of_sequence_fusion.hpp).
   virtual std::unique_ptr<Estimator> clone() const = 0;

@@ -2,12 +2,16 @@
 // Global pose from ranges alone, no prior: nonlinear least squares (Gauss-Newton) on [x, y, yaw]
 // from several starts. Used to initialize (and re-initialize) filters that track a pose.
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "beaconloc/core/pose2.hpp"
 
 namespace beaconloc {
+
+// Fewer ranges than this leave the three unknowns without a residual to judge the fix by.
+constexpr std::size_t kRangePoseMinObservations = 4;
 
 struct RangeObservation {
   Eigen::Vector2d receiver_solve_frame_m;  // receiver in the frame of the pose solved for
@@ -35,10 +39,24 @@ struct RangePoseSolution {
   Cov3 covariance = Cov3::Identity();  // (J^T R^-1 J)^-1 at the solution
   double weighted_residual_rms = 0.0;  // residuals in units of their sigma (of the ranges kept)
   std::size_t outliers = 0;            // ranges dropped by the outlier gate
-  std::string failure;                 // why ok is false
+  // The mirror image: Gauss-Newton from the fix reflected across the principal axis of the
+  // beacons it used (position and heading mirrored), on the same ranges. Its weighted cost less
+  // the fix's (a chi-square difference); +inf when that refinement finds no minimum or returns
+  // to the fix (within its covariance, chi-square 3 dof 99.9 %). Near 0 when the beacons lie on
+  // one line and the receivers cannot tell the two sides apart (one receiver, or a path along a
+  // straight line): the ranges do not say which of the two poses is the robot's. When the
+  // mirror fits better, it is the fix and the old fix its mirror.
+  double mirror_cost_margin = std::numeric_limits<double>::infinity();
+  std::string failure;  // why ok is false
 };
 
 RangePoseSolution solve_pose_from_ranges(const std::vector<RangeObservation>& observations,
                                          const RangePoseSolverOptions& options = {});
+
+// How well a pose explains ranges that may hold outliers: the sum of the squared residuals in
+// sigma, each capped at cap_sigma^2 (an echo costs as much however long its path). To compare
+// two poses on the same ranges.
+double truncated_range_cost(const std::vector<RangeObservation>& observations, const Pose2& pose,
+                            double cap_sigma);
 
 }  // namespace beaconloc
