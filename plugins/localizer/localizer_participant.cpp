@@ -157,7 +157,12 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   } else if (range_writer_lost_.load()) {
     status = msg::PARTICIPANT_STATUS_DEGRADED;
     message = "no live range writer: the decoder was lost";
-  } else if (worst == PoseStatus::kDegraded || worst == PoseStatus::kLost) {
+  } else if (core_.robot_count() == 0) {
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message = "no robot heard yet (no odometry)";
+  } else if (worst != PoseStatus::kOk) {
+    // A robot without a trusted pose (initializing, degraded, lost): not ok, whatever the
+    // others have; the message says what the initializing ones wait for.
     status = msg::PARTICIPANT_STATUS_DEGRADED;
   }
   // The robots without a pose yet, and what they wait for.

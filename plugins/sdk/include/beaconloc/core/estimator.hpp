@@ -132,7 +132,8 @@ class Estimator {
 InputResult check_range(const RangeMeasurement& range, const BeaconMap& map, std::size_t receiver_count);
 
 // The checks of a pose to reset an estimator from: finite, and a symmetric positive-definite
-// covariance. Accepted, or rejected("invalid_initial_pose").
+// covariance (rejected("invalid_initial_pose")), within the bounds of a site
+// (rejected("implausible_initial_pose")).
 InputResult check_initial_pose(const Pose2& pose_map_base, const Cov3& covariance);
 
 // Status policy shared by estimators: how long without a fused range the pose stays OK.
