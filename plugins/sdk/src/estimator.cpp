@@ -2,9 +2,9 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
-#include <cstdlib>
 #include <stdexcept>
 
+#include "beaconloc/core/decimal.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
 
 namespace beaconloc {
@@ -32,10 +32,10 @@ std::map<std::string, double> parse_estimator_parameters(const std::vector<std::
       throw std::invalid_argument(option_name + " '" + item + "' is not NAME=VALUE");
     }
     const std::string value = item.substr(eq + 1);
-    char* end = nullptr;
-    const double v = std::strtod(value.c_str(), &end);
-    if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(v)) {
-      throw std::invalid_argument(option_name + " '" + item + "': '" + value + "' is not a number");
+    double v = 0.0;
+    const NumberError e = parse_decimal(value, v);
+    if (e != NumberError::kNone) {
+      throw std::invalid_argument(option_name + " '" + item + "': " + number_problem("the value", value, e));
     }
     out[item.substr(0, eq)] = v;
   }

@@ -50,7 +50,8 @@ struct EstimatorConfig {
 };
 
 // NAME=VALUE items (the --param options) as estimator parameters. Throws std::invalid_argument
-// naming the option and the item that is not NAME=VALUE or whose value is not a finite number.
+// naming the option and the item that is not NAME=VALUE or whose value is not a decimal number
+// (core/decimal.hpp: "0x1p1", "inf", "1e400" are refused).
 std::map<std::string, double> parse_estimator_parameters(const std::vector<std::string>& items,
                                                          const std::string& option_name);
 
