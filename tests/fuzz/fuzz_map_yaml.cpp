@@ -53,7 +53,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string yaml = input.substr(0, at);
   const std::string image = at == std::string::npos ? std::string() : input.substr(at + separator.size());
   try {
-    const beaconloc::OccupancyGrid grid = beaconloc::parse_occupancy_grid(yaml, image, "fuzz.yaml", "fuzz.pgm");
+    const beaconloc::OccupancyGrid grid =
+        beaconloc::parse_occupancy_grid(yaml, image, "fuzz.yaml", "fuzz.pgm");
     // Every cell came from a pixel: the image held at least that many bytes.
     check(grid.width() > 0 && grid.height() > 0 &&
           static_cast<std::size_t>(grid.width()) * static_cast<std::size_t>(grid.height()) <= image.size());
