@@ -7,7 +7,7 @@ export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update
 $SUDO apt-get install -y --no-install-recommends \
   ca-certificates cmake g++ ninja-build make \
-  libfastrtps-dev libfastcdr-dev fastddsgen \
+  libfastrtps-dev libfastcdr-dev libtinyxml2-dev fastddsgen \
   libeigen3-dev libcli11-dev libyaml-cpp-dev \
   libgtest-dev libgmock-dev libbenchmark-dev \
   cyclonedds-dev cyclonedds-tools \

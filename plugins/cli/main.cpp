@@ -10,11 +10,13 @@
 
 #include "beaconloc/core/csv_reader.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
+#include "beaconloc/core/limits.hpp"
 #include "beaconloc/dds/stop_signal.hpp"
 #include "bridge_participant.hpp"
 #include "decoder_participant.hpp"
 #include "localizer_participant.hpp"
 #include "monitor.hpp"
+#include "number_options.hpp"
 #include "offline_run.hpp"
 #include "pipeline.hpp"
 #include "sim/faults.hpp"
@@ -25,25 +27,15 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// Validators whose messages name the rule, not the limits of a double.
-CLI::Validator bound(const char* name, bool strict) {
-  return CLI::Validator(
-      [strict](std::string& v) {
-        try {
-          const double x = std::stod(v);
-          if (strict ? x > 0.0 : x >= 0.0) return std::string();
-          return std::string(strict ? "must be > 0, got " : "must be >= 0, got ") + v;
-        } catch (const std::exception&) {
-          return "not a number: " + v;
-        }
-      },
-      name);
-}
-const CLI::Validator kPositive = bound("POSITIVE", true);
-const CLI::Validator kNonNegative = bound("NON-NEGATIVE", false);
+// The ranges of the numeric options (number_options.hpp validates every one): the physical
+// limits of core/limits.hpp where the option is one of those quantities.
+constexpr bool kOpen = true;         // (min, max]: the option must be > min
+constexpr double kMaxSpeed = 1e6;    // --speed: data seconds per wall-clock second
+constexpr double kMaxAgeMs = 6e4;    // --max-age-ms: a TOF's useful life, at most a minute
+constexpr double kMaxDelayMs = 1e4;  // --delay-ms of accuracy runs
 
 void add_dds_options(CLI::App* app, dds::DdsOptions& o) {
-  app->add_option("--domain", o.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+  app->add_option("--domain", o.domain_id, "DDS domain id")->transform(whole_in(0, 232));
   app->add_option("--participant-profile", o.participant_profile,
                   "participant profile of the QoS XML (default: loopback only)");
   app->add_option("--qos", o.extra_qos_files, "extra Fast DDS XML profiles file(s), loaded last")
@@ -59,10 +51,10 @@ void add_source_options(CLI::App* app, SourceChoice& s) {
   scenario->excludes(replay);
   app->add_option("--replay-wheel-base-m", s.replay.wheel_base_m,
                   "wheel base used to express a recording's (v, omega) as wheel velocities")
-      ->check(kPositive);
+      ->transform(real_in(0.0, kMaxWheelBaseM, kOpen));
   app->add_option("--replay-odometry-k-v", s.replay.odometry_k_v_m,
                   "odometry noise reported with replayed samples: sigma_v^2 = k_v |v| / dT per wheel")
-      ->check(kNonNegative);
+      ->transform(real_in(0.0, 1.0));
   app->add_option("--fault", s.faults,
                   "inject a fault into the simulation (repeatable): beacon_dies=ID@T, tof_outage=FROM:TO "
                   "(seconds), echoes=P");
@@ -72,20 +64,25 @@ void add_gateway_options(CLI::App* app, GatewayOptions& o, std::optional<std::ui
   app->add_option("--robot", o.robot_id, "robot id the samples carry");
   app->add_option("--duration-s", o.duration_s,
                   "seconds of data to run (0: a recording to its end, a simulation until stopped)")
-      ->check(kNonNegative);
-  app->add_option("--speed", o.speed, "data seconds per wall-clock second")->check(kPositive);
-  app->add_option("--seed", seed, "random seed of the simulated noise (default: the scenario's)");
+      ->transform(real_in(0.0, kMaxDurationS));
+  app->add_option("--speed", o.speed, "data seconds per wall-clock second")
+      ->transform(real_in(0.0, kMaxSpeed, kOpen));
+  app->add_option("--seed", seed, "random seed of the simulated noise (default: the scenario's)")
+      ->transform(any_unsigned());
   app->add_option("--truth-out", o.truth_csv, "write ground truth CSV here");
 }
 
 void add_decoder_options(CLI::App* app, TofDecoderConfig& o, double& max_age_ms) {
-  app->add_option("--min-range-m", o.min_range_m, "shortest plausible range")->check(kNonNegative);
-  app->add_option("--max-range-m", o.max_range_m, "longest plausible range")->check(kPositive);
-  app->add_option("--range-sigma-m", o.range_sigma_m, "standard deviation of a range")->check(kPositive);
+  app->add_option("--min-range-m", o.min_range_m, "shortest plausible range")
+      ->transform(real_in(0.0, kMaxRangeM));
+  app->add_option("--max-range-m", o.max_range_m, "longest plausible range")
+      ->transform(real_in(0.0, kMaxRangeM, kOpen));
+  app->add_option("--range-sigma-m", o.range_sigma_m, "standard deviation of a range")
+      ->transform(real_in(0.0, 100.0, kOpen));
   app->add_option("--range-scale", o.range_scale, "ranging calibration: range = c * tof / scale")
-      ->check(kPositive);
+      ->transform(real_in(0.1, 10.0));
   app->add_option("--max-age-ms", max_age_ms, "a TOF fired this long before the newest is stale")
-      ->check(kPositive);
+      ->transform(real_in(0.0, kMaxAgeMs, kOpen));
 }
 
 // with_robot_filter / with_circle: false where --robot names the simulated robot and the source
@@ -101,16 +98,18 @@ void add_localizer_options(CLI::App* app, LocalizerSettings& o, bool standalone)
   app->add_option("--initial-pose", o.initial_pose,
                   "X Y YAW: where the robot starts, for estimators placed by hand (default in run and demo: "
                   "the scenario's start)")
-      ->expected(3);
+      ->expected(3)
+      ->transform(real_in(-kMaxMapCoordinateM, kMaxMapCoordinateM));
   if (!standalone) return;
   app->add_option("--robot", o.robot, "serve only this robot id (default: every robot)");
   app->add_option("--receiver-radius-m", o.receiver_radius_m,
                   "without --receivers: receivers on a circle of this radius")
-      ->check(kPositive);
+      ->transform(real_in(0.0, kMaxReceiverOffsetM, kOpen));
   app->add_option("--receiver-count", o.receiver_count,
                   "without --receivers: number of receivers on the circle")
-      ->check(CLI::Range(1, 16));
-  app->add_option("--receiver-height-m", o.receiver_height_m, "receivers' height above the floor");
+      ->transform(whole_in(1, 16));
+  app->add_option("--receiver-height-m", o.receiver_height_m, "receivers' height above the floor")
+      ->transform(real_in(-kMaxReceiverOffsetM, kMaxReceiverOffsetM));
 }
 
 void add_bridge_options(CLI::App* app, bridge::BridgeOptions& o, LocalizerSettings& receivers) {
@@ -120,13 +119,14 @@ void add_bridge_options(CLI::App* app, bridge::BridgeOptions& o, LocalizerSettin
   app->add_option("--odom-frame", o.odom_frame, "odometry frame (REP-105)");
   app->add_option("--base-frame", o.base_frame, "robot base frame (REP-105)");
   app->add_option("--receivers", receivers.receivers, "receivers in the robot frame, x:y[,x:y...] (m)");
-  app->add_option("--receiver-height-m", receivers.receiver_height_m, "receivers' height above the floor");
+  app->add_option("--receiver-height-m", receivers.receiver_height_m, "receivers' height above the floor")
+      ->transform(real_in(-kMaxReceiverOffsetM, kMaxReceiverOffsetM));
   app->add_flag("--odom-in", o.odometry_in,
                 "feed the localizer from rt/<ns>/odom (nav_msgs/Odometry of the robot's driver)");
   app->add_flag("--scan-in", o.scan_in, "feed the localizer from rt/<ns>/scan (sensor_msgs/LaserScan)");
   app->add_option("--wheel-base-m", o.wheel_base_m,
                   "wheel base to express the driver's twist as wheel speeds")
-      ->check(kPositive);
+      ->transform(real_in(0.0, kMaxWheelBaseM, kOpen));
 }
 
 void run_until_stopped() {
@@ -220,7 +220,7 @@ int run(int argc, char** argv) {
   eval->add_option("--beacons", beacons_file, "beacons CSV to draw (beacon_id,x_m,y_m,z_m)")
       ->check(CLI::ExistingFile);
   eval->add_option("--max-truth-gap-s", max_truth_gap_s, "interpolate truth over gaps up to this long")
-      ->check(kPositive);
+      ->transform(real_in(0.0, 3600.0, kOpen));
 
   std::vector<std::string> accuracy_scenarios, accuracy_estimators{"range_ekf"}, accuracy_parameters;
   int accuracy_seeds = 10;
@@ -236,15 +236,15 @@ int run(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   accuracy->add_option("--estimator", accuracy_estimators, "estimator (repeatable; default range_ekf)");
-  accuracy->add_option("--seeds", accuracy_seeds, "number of seeds")->check(CLI::Range(1, 1000));
-  accuracy->add_option("--first-seed", accuracy_first_seed, "first seed");
+  accuracy->add_option("--seeds", accuracy_seeds, "number of seeds")->transform(whole_in(1, 1000));
+  accuracy->add_option("--first-seed", accuracy_first_seed, "first seed")->transform(any_unsigned());
   accuracy->add_option("--settle-s", accuracy_settle_s, "seconds after the first pose not scored")
-      ->check(kNonNegative);
+      ->transform(real_in(0.0, kMaxDurationS));
   accuracy->add_option("--param", accuracy_parameters, "estimator parameter NAME=VALUE for every estimator");
   accuracy
       ->add_option("--odometry-k-v-m", accuracy_odometry_k_v_m,
                    "replace the scenarios' odometry noise k_v (sigma_v^2 = k_v |v| / dT per wheel)")
-      ->check(kNonNegative);
+      ->transform(real_in(0.0, 1.0));
   accuracy
       ->add_option("--table", accuracy_table,
                    "pose: E_p, E_phi, E_S, NEES (seed 000 Table II); distance: mean, std, RMSE, max of the "
@@ -261,7 +261,7 @@ int run(int argc, char** argv) {
       ->add_option("--delay-ms", accuracy_delay_ms,
                    "also score with every TOF and scan delivered late by a uniform random 0..D ms "
                    "(odometry on time); the in-order row comes first")
-      ->check(kNonNegative);
+      ->transform(real_in(0.0, kMaxDelayMs));
 
   auto* monitor = app.add_subcommand(
       "monitor",
@@ -270,7 +270,7 @@ int run(int argc, char** argv) {
       "two localizers; with --truth, the accuracy");
   add_dds_options(monitor, dds_options);
   monitor->add_option("--duration-s", monitor_duration_s, "stop after this many seconds (0: until stopped)")
-      ->check(kNonNegative);
+      ->transform(real_in(0.0, kMaxDurationS));
   monitor->add_option("--truth", truth_file, "ground truth CSV written by the gateway");
   monitor->add_option("--out", estimate_file, "write every pose to this CSV at the end");
 

@@ -15,6 +15,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "beaconloc/core/decimal.hpp"
+#include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/occupancy_grid_io.hpp"
 #include "beaconloc/dds/stop_signal.hpp"
 #include "decoder_participant.hpp"
@@ -350,15 +352,13 @@ std::vector<std::pair<std::string, std::string>> split_pairs(const std::string& 
   return out;
 }
 
-double parse_double(const std::string& text, const std::string& what) {
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(text, &used);
-    if (used != text.size() || !std::isfinite(v)) throw std::invalid_argument(text);
-    return v;
-  } catch (const std::exception&) {
-    throw std::invalid_argument(what + ": '" + text + "' is not a number");
-  }
+// A coordinate of --receivers: decimal (core/decimal.hpp), within kMaxReceiverOffsetM of the
+// robot's centre.
+double receiver_coordinate(const std::string& text) {
+  const double v = decimal_or_throw(text, "--receivers");
+  if (std::abs(v) > kMaxReceiverOffsetM)
+    throw std::invalid_argument(range_problem("--receivers", v, -kMaxReceiverOffsetM, kMaxReceiverOffsetM));
+  return v;
 }
 
 }  // namespace
@@ -392,8 +392,7 @@ EstimatorConfig LocalizerSettings::config(const std::optional<ReceiverArray>& fa
   EstimatorConfig c;
   if (!receivers.empty()) {
     for (const auto& [x, y] : split_pairs(receivers, ',', ':')) {
-      c.receivers.receivers_base_m.emplace_back(parse_double(x, "--receivers"),
-                                                parse_double(y, "--receivers"));
+      c.receivers.receivers_base_m.emplace_back(receiver_coordinate(x), receiver_coordinate(y));
     }
     c.receivers.receiver_height_m = receiver_height_m;
   } else if (fallback) {

@@ -1,15 +1,15 @@
 #include "evaluation.hpp"
 
 #include <Eigen/Cholesky>
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
 #include "beaconloc/core/csv_reader.hpp"
+#include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/pose_error.hpp"
 
 namespace beaconloc {
@@ -19,24 +19,27 @@ namespace {
 constexpr double kChi2Band2[2] = {0.0506, 7.3778};
 constexpr double kChi2Band3[2] = {0.2158, 9.3484};
 
+// A stamp of the source clock in ns: the simulator's from 0, a recording's (from 0), the wall
+// clock's since 1970; never negative.
 StampNs stamp(const CsvReader& csv, const std::string& column) {
-  const std::string& cell = csv.cell(column);
-  errno = 0;
-  char* end = nullptr;
-  const long long v = std::strtoll(cell.c_str(), &end, 10);
-  if (cell.empty() || errno != 0 || end != cell.c_str() + cell.size()) {
-    throw CsvError(csv.where() + ": " + column + " '" + cell + "' is not an integer stamp in ns");
-  }
+  StampNs v = 0;
+  std::string problem;
+  if (csv.read(column, v, 0, std::numeric_limits<StampNs>::max(), problem) != NumberError::kNone)
+    throw CsvError(csv.where() + ": " + problem + " (a stamp in ns)");
   return v;
 }
 
-double number(const CsvReader& csv, const std::string& column) {
+double number(const CsvReader& csv, const std::string& column, double limit) {
   double v = 0.0;
-  if (!parse_finite(csv.cell(column), v)) {
-    throw CsvError(csv.where() + ": " + column + " '" + csv.cell(column) + "' is not a finite number");
-  }
+  std::string problem;
+  if (csv.read(column, v, -limit, limit, problem) != NumberError::kNone)
+    throw CsvError(csv.where() + ": " + problem);
   return v;
 }
+double position(const CsvReader& csv, const std::string& column) {
+  return number(csv, column, kMaxMapCoordinateM);
+}
+double angle(const CsvReader& csv, const std::string& column) { return number(csv, column, kMaxAngleRad); }
 
 void require_complete(const CsvReader& csv) {
   if (!csv.complete()) throw CsvError(csv.where() + ": expected " + std::to_string(csv.width()) + " columns");
@@ -155,7 +158,7 @@ TruthTrack load_truth_csv(const std::string& path) {
     require_complete(csv);
     const bool has_yaw = !csv.cell("yaw_rad").empty();
     truth.add(stamp(csv, "stamp_ns"),
-              {number(csv, "x_m"), number(csv, "y_m"), has_yaw ? number(csv, "yaw_rad") : 0.0}, has_yaw);
+              {position(csv, "x_m"), position(csv, "y_m"), has_yaw ? angle(csv, "yaw_rad") : 0.0}, has_yaw);
   }
   return truth;
 }
@@ -168,10 +171,10 @@ std::vector<EstimateRow> load_estimates_csv(const std::string& path) {
     EstimateRow r;
     r.robot_id = csv.cell("robot_id");
     r.estimate.stamp_ns = stamp(csv, "stamp_ns");
-    r.estimate.pose_map_base = {number(csv, "x_m"), number(csv, "y_m"), number(csv, "yaw_rad")};
+    r.estimate.pose_map_base = {position(csv, "x_m"), position(csv, "y_m"), angle(csv, "yaw_rad")};
     for (int i = 0; i < 9; ++i) {
-      r.estimate.covariance(i / 3, i % 3) =
-          number(csv, "cov_" + std::to_string(i / 3) + std::to_string(i % 3));
+      r.estimate.covariance(i / 3, i % 3) = number(
+          csv, "cov_" + std::to_string(i / 3) + std::to_string(i % 3), std::numeric_limits<double>::max());
     }
     r.estimate.status = status_from(csv.cell("status"), csv.where());
     r.estimator = csv.cell("estimator");

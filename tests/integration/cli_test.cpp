@@ -2,6 +2,7 @@
 // argument or configuration with a non-zero exit, a clean stop on signals, and the demo.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -105,6 +106,62 @@ TEST(Cli, EveryCommandRefusesABadEstimatorParameterAtStart) {
                                                                                          << negative_text;
   }
   std::filesystem::remove_all(out);
+}
+
+// Every number of the command line, and of the files it names, is a decimal number within its
+// range; the error names the option as typed, or the file, line and key (issue 23, items 3, 7
+// and 13). Each of these ends before any participant joins a domain.
+TEST(Cli, NumbersOfOptionsAndFilesAreRangeCheckedNamingTheCulprit) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("beaconloc-cli-numbers-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string qos = (dir / "loopback.xml").string();
+  std::ofstream(qos) << "<?xml version=\"1.0\"?>\n<profiles xmlns=\"http://www.eprosima.com/XMLSchemas/"
+                        "fastRTPS_Profiles\">\n  <participant profile_name=\"beaconloc.loopback\"><rtps/>"
+                        "</participant>\n</profiles>\n";
+  const std::string map = (dir / "map.yaml").string();
+  std::ofstream(map) << "image: map.pgm\nresolution: 1e-300\norigin: [0, 0, 0]\n";
+  std::ofstream(dir / "map.pgm") << "P2\n1 1\n255\n0\n";
+  const std::string scenario = (dir / "twice.yaml").string();
+  {  // the default scenario with a second range_sigma_m line after its own (line 25)
+    std::ifstream in(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/default.yaml");
+    std::ofstream out(scenario);
+    for (std::string line; std::getline(in, line);) {
+      out << line << '\n';
+      if (line.rfind("  range_sigma_m:", 0) == 0) out << "  range_sigma_m: 0.5\n";
+    }
+  }
+  DomainLease lease;  // the cases end before joining it; a lease all the same
+  const std::string domain = std::to_string(lease.id());
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"decoder", "--max-age-ms", "1e300"}, "--max-age-ms: '1e300' is outside (0, 60000]"},
+      {{"gateway", "--seed", "-1"}, "--seed: '-1' is outside [0, 18446744073709551615]"},
+      {{"decoder", "--max-range-m", "0x1p1"}, "--max-range-m: '0x1p1' is not a decimal number"},
+      {{"gateway", "--duration-s", "1e300"}, "--duration-s: '1e300' is outside [0, 1e+06]"},
+      {{"localizer", "--receiver-count", "3.5"}, "--receiver-count: '3.5' is not a whole decimal number"},
+      {{"localizer", "--initial-pose", "0", "0", "inf"}, "--initial-pose: 'inf' is not a decimal number"},
+      {{"localizer", "--domain", domain, "--receivers", "0:1e300"},
+       "--receivers 1e+300 is outside [-10, 10]"},
+      {{"localizer", "--domain", domain, "--param", "nis_gate=0x1p1"},
+       "--param 'nis_gate=0x1p1': the value '0x1p1' is not a decimal number"},
+      {{"localizer", "--domain", domain, "--map", map},
+       "map.yaml:2: resolution 1e-300 is outside [0.001, 10]"},
+      {{"localizer", "--domain", domain, "--qos", qos},
+       "loopback.xml':3: participant 'beaconloc.loopback' is already defined (built in, or by an earlier "
+       "file)"},
+      {{"gateway", "--domain", domain, "--scenario", scenario},
+       "twice.yaml:26: 'beacon_system.range_sigma_m' is repeated (first at line 25)"},
+      {{"accuracy", "--scenario", scenario, "--seeds", "0x10"},
+       "--seeds: '0x10' is not a whole decimal number"},
+  };
+  for (const auto& [args, message] : cases) {
+    auto [code, out] = beaconloc(args);
+    std::string joined;
+    for (const auto& a : args) joined += a + " ";
+    EXPECT_NE(code, 0) << joined;
+    EXPECT_NE(out.find(message), std::string::npos) << joined << "\n" << out;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Cli, ParticipantsStopCleanlyOnSigintAndSigterm) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "beaconloc/core/csv_reader.hpp"
 #include "svg_plot.hpp"
 
 namespace beaconloc {
@@ -109,6 +110,49 @@ TEST(Evaluation, FilesRoundTripAndPlotsAreWritten) {
     FAIL();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("bad.csv:2"), std::string::npos) << e.what();
+  }
+}
+
+// The truth and estimate CSVs: every number decimal and within its column's range, named with
+// the file, line and column; a byte order mark before the header is an encoding mark.
+TEST(Evaluation, EveryNumberOfTheCsvFilesIsCheckedNamingItsColumn) {
+  const std::string dir = ::testing::TempDir() + "/evaluation_numbers";
+  std::filesystem::create_directories(dir);
+  const auto truth_error = [&](const std::string& text) {
+    std::ofstream(dir + "/truth.csv") << text;
+    try {
+      load_truth_csv(dir + "/truth.csv");
+    } catch (const CsvError& e) {
+      const std::string what = e.what();
+      return what.substr(what.find("truth.csv"));
+    }
+    return std::string();
+  };
+  const std::string header = "stamp_ns,x_m,y_m,yaw_rad\n";
+  EXPECT_EQ(truth_error(header + "1,0x1p1,0,0\n"), "truth.csv:2: x_m '0x1p1' is not a decimal number");
+  EXPECT_EQ(truth_error(header + "1,1e300,0,0\n"), "truth.csv:2: x_m 1e+300 is outside [-1e+06, 1e+06]");
+  EXPECT_EQ(truth_error(header + "1,0,1e400,0\n"), "truth.csv:2: y_m '1e400' is out of range");
+  EXPECT_EQ(truth_error(header + "1,0,0,1e7\n"), "truth.csv:2: yaw_rad 1e+07 is outside [-1e+06, 1e+06]");
+  EXPECT_EQ(truth_error(header + "1.5,0,0,0\n"),
+            "truth.csv:2: stamp_ns '1.5' is not a decimal number (a stamp in ns)");
+  EXPECT_EQ(truth_error(header + "-1,0,0,0\n"),
+            "truth.csv:2: stamp_ns -1 is outside [0, 9223372036854775807] (a stamp in ns)");
+  EXPECT_EQ(truth_error(header + "0x10,0,0,0\n"),
+            "truth.csv:2: stamp_ns '0x10' is not a decimal number (a stamp in ns)");
+  EXPECT_EQ(truth_error("\xEF\xBB\xBF" + header + "1,0.5,0,0\n"), "");
+  EXPECT_EQ(load_truth_csv(dir + "/truth.csv").samples().size(), 1u);
+  EXPECT_EQ(truth_error("stamp_ns,x_m,y_m,yaw_rad,x_m\n1,0,0,0,1\n"),
+            "truth.csv:1: header names column 'x_m' twice");
+  std::ofstream(dir + "/estimate.csv") << "\xEF\xBB\xBFrobot_id,stamp_ns,x_m,y_m,yaw_rad,cov_00,cov_01,cov_"
+                                          "02,cov_10,cov_11,cov_12,cov_20,cov_21,"
+                                          "cov_22,status,estimator\nr,1,0,0,0,1,0,0,0,1,0,0,0,inf,ok,e\n";
+  try {
+    load_estimates_csv(dir + "/estimate.csv");
+    FAIL() << "an infinite covariance loaded";
+  } catch (const CsvError& e) {
+    EXPECT_NE(std::string(e.what()).find("estimate.csv:2: cov_22 'inf' is not a decimal number"),
+              std::string::npos)
+        << e.what();
   }
 }
 

@@ -9,6 +9,7 @@
 #include <limits>
 #include <string>
 
+#include "beaconloc/core/csv_reader.hpp"
 #include "beaconloc/core/occupancy_grid_io.hpp"
 #include "evaluation.hpp"
 #include "replay/replay_source.hpp"
@@ -80,7 +81,7 @@ TEST(FuzzRegression, ScenarioMapOfMoreThan1e8CellsIsAScenarioError) {
   const std::string trajectory = "trajectory:\n  waypoints_m: [[0, 0], [1, 0]]\n  speed_mps: 0.5\n";
   EXPECT_EQ(
       scenario_error(kMinimalScenario + trajectory + "map:\n  resolution_m: 0.005\n  size_m: [100, 100]\n"),
-      "fuzz.yaml:11: 'map.size_m' must be positive and at most 20000 cells a side, 1e8 cells in all");
+      "fuzz.yaml:11: 'map.size_m' must be positive and at most 20000 cells a side, 100000000 cells in all");
   std::string obstacles;
   for (int i = 0; i < 12; ++i)
     obstacles += "    - {min_m: [" + std::to_string(i) + ", 0], max_m: [50, 49]}\n";
@@ -154,8 +155,8 @@ TEST(FuzzRegression, DecoderJudgesFreshnessAtTheEndsOfTheClock) {
 
 // fuzz_replay_csv: a range of 5e14 m (a time of flight of 1.5e12 s, beyond the int64 ns clock)
 // made s_to_ns return INT64_MIN and the firing stamp (arrival - TOF) overflow; a t_s as large
-// overflowed the out-of-order note. Each such row is now refused, counted as invalid_value, and
-// the rest of the recording loads.
+// overflowed the out-of-order note. Each such row is now refused, counted as invalid_<column>,
+// and the rest of the recording loads.
 TEST(FuzzRegression, ReplayRefusesTimesBeyondTheClock) {
   const auto dir =
       std::filesystem::temp_directory_path() / ("beaconloc_fuzz_replay_" + std::to_string(::getpid()));
@@ -164,13 +165,17 @@ TEST(FuzzRegression, ReplayRefusesTimesBeyondTheClock) {
   std::ofstream(dir / "odom.csv") << "t_s,dt_s,v_mps,omega_radps\n1.0,0.1,0.5,0\n1e300,0.1,0.5,0\n"
                                      "4.6e9,1,0.5,0\n";
   std::ofstream(dir / "ranges.csv")
-      << "t_s,beacon_id,range_m\n0.127943993,1,2.9\n-1e300,1,3.0\n1.0,159.,502522014829822\n";
+      << "t_s,beacon_id,range_m\n0.127943993,1,2.9\n-1e300,1,3.0\n1.0,159.,502522014829822\n"
+         "1.0,159,502522014829822\n";
   std::ofstream(dir / "gt.csv") << "t_s,x_m,y_m\n1.0,0,0\n-9.3e9,0,0\n";
   ReplaySource replay(dir.string());
   const auto& c = replay.load_counts();
-  EXPECT_EQ(c.rejected("odom.invalid_value"), 2u);  // 1e300, and 4.6e9 + 1 s: its end
-  EXPECT_EQ(c.rejected("ranges.invalid_value"), 2u);
-  EXPECT_EQ(c.rejected("gt.invalid_value"), 1u);
+  EXPECT_EQ(c.rejected("odom.invalid_t_s"), 1u);   // 1e300
+  EXPECT_EQ(c.rejected("odom.invalid_dt_s"), 1u);  // 4.6e9 + 1 s: its end
+  EXPECT_EQ(c.rejected("ranges.invalid_t_s"), 1u);
+  EXPECT_EQ(c.rejected("ranges.invalid_range_m"), 1u);  // 5e14 m, as found with beacon id 159
+  EXPECT_EQ(c.rejected("ranges.malformed_row"), 1u);    // as found: the beacon id "159." is not whole
+  EXPECT_EQ(c.rejected("gt.invalid_t_s"), 1u);
   EXPECT_EQ(replay.event_count(), 3u);  // one odometry, one range, one truth row
   EXPECT_TRUE(replay.load_notes().empty());
   std::filesystem::remove_all(dir);
@@ -178,20 +183,36 @@ TEST(FuzzRegression, ReplayRefusesTimesBeyondTheClock) {
 
 // fuzz_eval_csv (an input written by hand while reviewing the target; the fuzzer had not reached
 // it in 10 minutes): truth rows at both ends of the clock overflowed the gap between them in
-// TruthTrack::at, and estimates as far apart overflowed error_series' time axis.
+// TruthTrack::at, and estimates as far apart overflowed error_series' time axis. The CSV files now
+// refuse a negative stamp (no source clock has one); the evaluation still takes any two stamps.
 TEST(FuzzRegression, EvaluationOfStampsAtBothEndsOfTheClockDoesNotOverflow) {
   const auto dir =
       std::filesystem::temp_directory_path() / ("beaconloc_fuzz_eval_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
-  std::ofstream(dir / "truth.csv") << "stamp_ns,x_m,y_m,yaw_rad\n-9000000000000000000,0,0,0\n"
-                                      "9000000000000000000,1,1,0\n";
-  std::ofstream(dir / "estimate.csv")
-      << "robot_id,stamp_ns,x_m,y_m,yaw_rad,cov_00,cov_01,cov_02,cov_10,cov_11,cov_12,cov_20,cov_21,cov_22,"
-         "status,estimator\n"
-         "r,-9000000000000000000,0,0,0,1,0,0,0,1,0,0,0,1,ok,e\nr,0,0,0,0,1,0,0,0,1,0,0,0,1,ok,e\n"
-         "r,9000000000000000000,1,1,0,1,0,0,0,1,0,0,0,1,ok,e\n";
-  const TruthTrack truth = load_truth_csv((dir / "truth.csv").string());
-  const auto rows = load_estimates_csv((dir / "estimate.csv").string());
+  std::ofstream(dir / "truth.csv") << "stamp_ns,x_m,y_m,yaw_rad\n-9000000000000000000,0,0,0\n";
+  try {
+    load_truth_csv((dir / "truth.csv").string());
+    FAIL() << "a negative stamp loaded";
+  } catch (const CsvError& e) {
+    EXPECT_NE(std::string(e.what()).find("truth.csv:2: stamp_ns -9000000000000000000 is outside [0, "),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove_all(dir);
+  TruthTrack truth;
+  truth.add(-9'000'000'000'000'000'000, {0, 0, 0}, true);
+  truth.add(9'000'000'000'000'000'000, {1, 1, 0}, true);
+  std::vector<EstimateRow> rows;
+  for (const StampNs stamp :
+       {StampNs{-9'000'000'000'000'000'000}, StampNs{0}, StampNs{9'000'000'000'000'000'000}}) {
+    EstimateRow r;
+    r.robot_id = "r";
+    r.estimator = "e";
+    r.estimate.stamp_ns = stamp;
+    r.estimate.pose_map_base = stamp > 0 ? Pose2(1, 1, 0) : Pose2(0, 0, 0);
+    r.estimate.status = PoseStatus::kOk;
+    rows.push_back(r);
+  }
   EXPECT_FALSE(truth.at(0, kMaxStamp).has_value());  // 1.8e19 ns between the rows: wider than any gap
   EvaluationOptions every_stamp;
   every_stamp.score_from_ns = kMinStamp;
@@ -202,7 +223,6 @@ TEST(FuzzRegression, EvaluationOfStampsAtBothEndsOfTheClockDoesNotOverflow) {
   ASSERT_EQ(errors.size(), 2u);
   EXPECT_EQ(errors[0].t_s, 0.0);
   EXPECT_DOUBLE_EQ(errors[1].t_s, 1.8e10);
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

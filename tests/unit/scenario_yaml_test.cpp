@@ -111,5 +111,39 @@ TEST(ScenarioYaml, ErrorsNameTheKeyAndLine) {
   }
 }
 
+// A scenario with two range_sigma_m lines gave no pose and no hint why (the first silently won):
+// a key given twice, at any depth, is an error naming it and both lines.
+TEST(ScenarioYaml, AKeyGivenTwiceIsAnErrorNamingItAndItsLines) {
+  EXPECT_EQ(error_of(std::string(kMinimal) +
+                     "beacon_system:\n  range_sigma_m: 0.01\n  max_range_m: 5\n  range_sigma_m: 0.5\n"),
+            "test.yaml:12: 'beacon_system.range_sigma_m' is repeated (first at line 10)");
+  EXPECT_EQ(error_of(std::string(kMinimal) + "name: u\n"),
+            "test.yaml:9: 'name' is repeated (first at line 1)");
+  std::string nested = kMinimal;
+  nested.replace(nested.find("[0, 0, 2]}"), 10, "[0, 0, 2], id: 2}");
+  EXPECT_EQ(error_of(nested), "test.yaml:3: 'beacons[0].id' is repeated (first at line 3)");
+}
+
+// Every number of a scenario is decimal (core/decimal.hpp) and whole where it counts things.
+TEST(ScenarioYaml, NumbersAreDecimalAndCountsWhole) {
+  EXPECT_EQ(error_of(std::string(kMinimal) + "beacon_system: {range_sigma_m: 0x1p1}\n"),
+            "test.yaml:9: 'beacon_system.range_sigma_m' is not a decimal number ('0x1p1')");
+  EXPECT_EQ(error_of(std::string(kMinimal) + "beacon_system: {range_sigma_m: .inf}\n"),
+            "test.yaml:9: 'beacon_system.range_sigma_m' is not a decimal number ('.inf')");
+  EXPECT_EQ(error_of(std::string(kMinimal) + "duration_s: 1e400\n"),
+            "test.yaml:9: 'duration_s' is out of range ('1e400')");
+  EXPECT_EQ(error_of(std::string(kMinimal) + "seed: -1\n"), "test.yaml:9: 'seed' is out of range ('-1')");
+  std::string circle = kMinimal;
+  circle.replace(circle.find("{positions_m: [[0, 0]]}"), 23, "{circle: {radius_m: 0.2, count: 3.5}}");
+  EXPECT_EQ(error_of(circle), "test.yaml:5: 'robot.receivers.circle.count' is not a decimal number ('3.5')");
+  std::string far = kMinimal;
+  far.replace(far.find("[[0, 0]]"), 8, "[[0, 1e300]]");
+  EXPECT_EQ(error_of(far),
+            "test.yaml:5: 'robot.receivers.positions_m[0][1]' must be in [-10, 10], got 1e+300");
+  std::string octal = kMinimal;
+  octal.replace(octal.find("id: 1"), 5, "id: 010");
+  EXPECT_EQ(parse_scenario(octal).beacons.front().id, 10u);  // decimal, not octal
+}
+
 }  // namespace
 }  // namespace beaconloc::sim

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <vector>
 
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/occupancy_grid_io.hpp"
@@ -44,6 +45,23 @@ TEST(LaserModel, ExpectedRangesAreExactToTheCellFace) {
   beams.max_range_m = 5.0;
   expected_laser_ranges(empty, Pose2(1.05, 1.25, 0.0), beams, r);
   EXPECT_EQ(r[1], 5.0);
+}
+
+// The laser model casts a ray per beam per sigma point: from a pose far off the map (a diverged
+// estimate, a robot placed by a typo) every beam still ends at once and reads what it meets or the
+// maximum range (ray casting walks at most width + height cells; issue 23, item 3).
+TEST(LaserModel, APoseFarOffTheMapReadsFiniteRangesAtOnce) {
+  const OccupancyGrid grid = room();
+  LaserBeams beams;
+  for (int k = 0; k < 181; ++k) beams.add_beam((k - 90) * M_PI / 180.0);
+  beams.max_range_m = 1e300;
+  std::vector<double> r(beams.size());
+  for (const Pose2& pose : {Pose2(-1e12, 1.5, 0.0), Pose2(1e300, -1e300, 2.0), Pose2(1e9, 1e9, -2.4)}) {
+    expected_laser_ranges(grid, pose, beams, r.data());
+    for (double range : r) EXPECT_TRUE(std::isfinite(range) && range > 0.0);
+  }
+  expected_laser_ranges(grid, Pose2(-1e12, 1.5, 0.0), beams, r.data());
+  EXPECT_NEAR(r[90], 1e12, 1e-3);  // straight ahead: the room's west wall, 1e12 m away
 }
 
 TEST(BeaconAssociation, PicksTheBeaconWhosePredictedRangeExplainsTheMeasurement) {

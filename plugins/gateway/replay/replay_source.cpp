@@ -1,23 +1,22 @@
 #include "replay_source.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <sstream>
 
 #include "beaconloc/core/csv_reader.hpp"
+#include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/speed_of_sound.hpp"
 
 namespace beaconloc {
 namespace {
 
-// Times the replay can stamp: within 4.6e9 s (146 years) of the recording's zero, so that a time
-// and a time minus a time of flight as long are int64 nanoseconds.
-bool stampable(double t_s) { return std::abs(t_s) <= 4.6e9; }
+// An odometry row's interval (dt_s) is at most an hour: a longer one is no odometry.
+constexpr double kMaxOdometryIntervalS = 3600.0;
+constexpr double kAnyFinite = std::numeric_limits<double>::max();
 
 }  // namespace
 
@@ -36,9 +35,25 @@ void ReplaySource::refuse(const std::string& file, std::size_t line, const std::
     problems_.push_back(directory_ + "/" + file + ".csv:" + std::to_string(line) + ": " + detail);
 }
 
+bool ReplaySource::complete(const CsvReader& csv, const std::string& file) {
+  if (csv.complete()) return true;
+  refuse(file, csv.line(), "malformed_row", csv.cell_count_problem());
+  return false;
+}
+
+bool ReplaySource::take(const CsvReader& csv, const std::string& file, const std::string& column, double& out,
+                        double min, double max) {
+  std::string problem;
+  const NumberError e = csv.read(column, out, min, max, problem);
+  if (e == NumberError::kNone) return true;
+  refuse(file, csv.line(), e == NumberError::kNotDecimal ? "malformed_row" : "invalid_" + column, problem);
+  return false;
+}
+
 ReplaySource::ReplaySource(const std::string& directory, ReplayOptions options)
     : directory_(directory), options_(options) {
-  if (!(options_.wheel_base_m > 0.0)) throw ReplayError("replay wheel base must be > 0");
+  if (!(options_.wheel_base_m > 0.0 && options_.wheel_base_m <= kMaxWheelBaseM))
+    throw ReplayError("replay wheel base must be in (0, " + std::to_string(kMaxWheelBaseM) + "] m");
   load_beacons(directory + "/beacons.csv");
   load_odometry(directory + "/odom.csv");
   load_ranges(directory + "/ranges.csv");
@@ -67,39 +82,66 @@ void ReplaySource::load_beacons(const std::string& path) {
 void ReplaySource::load_odometry(const std::string& path) {
   CsvReader csv = open(path, {"t_s", "dt_s", "v_mps", "omega_radps"});
   const bool has_half_track = csv.has_column("half_track_m");
-  StampNs previous_end = std::numeric_limits<StampNs>::min();
+  StampNs previous_start = 0, previous_end = std::numeric_limits<StampNs>::min();
+  std::size_t previous_line = 0;
   while (csv.next()) {
     double t = 0, dt = 0, v = 0, w = 0, half_track = options_.wheel_base_m / 2.0;
-    if (!csv.complete() || !parse_finite(csv.cell("t_s"), t) || !parse_finite(csv.cell("dt_s"), dt) ||
-        !parse_finite(csv.cell("v_mps"), v) || !parse_finite(csv.cell("omega_radps"), w) ||
-        (has_half_track && !parse_finite(csv.cell("half_track_m"), half_track))) {
-      refuse("odom", csv.line(), "malformed_row", "not " + std::to_string(csv.width()) + " finite numbers");
+    if (!complete(csv, "odom") || !take(csv, "odom", "t_s", t, 0.0, kMaxFileStampS) ||
+        !take(csv, "odom", "dt_s", dt, 0.0, kMaxOdometryIntervalS) ||
+        !take(csv, "odom", "v_mps", v, -kMaxWheelSpeedMps, kMaxWheelSpeedMps) ||
+        !take(csv, "odom", "omega_radps", w, -kAnyFinite, kAnyFinite) ||
+        (has_half_track && !take(csv, "odom", "half_track_m", half_track, 0.0, kMaxWheelBaseM / 2.0))) {
       continue;
     }
-    if (!(dt > 0.0) || !(half_track > 0.0)) {
-      refuse("odom", csv.line(), "invalid_value", "dt_s and half_track_m must be > 0");
+    if (!(dt > 0.0)) {
+      refuse("odom", csv.line(), "invalid_dt_s", "dt_s " + csv.cell("dt_s") + " must be > 0");
       continue;
     }
-    if (!stampable(t) || !stampable(t + dt)) {
-      refuse("odom", csv.line(), "invalid_value", "t_s and t_s + dt_s must lie within 4.6e9 s of 0");
+    if (!(half_track > 0.0)) {
+      refuse("odom", csv.line(), "invalid_half_track_m",
+             "half_track_m " + csv.cell("half_track_m") + " must be > 0");
+      continue;
+    }
+    if (t + dt > kMaxFileStampS) {
+      refuse("odom", csv.line(), "invalid_dt_s", range_problem("t_s + dt_s", t + dt, 0.0, kMaxFileStampS));
+      continue;
+    }
+    // (v, omega) become wheel speeds v +- omega * B/2: each within the physical limit.
+    const double right = v + w * half_track, left = v - w * half_track;
+    if (!(std::abs(right) <= kMaxWheelSpeedMps && std::abs(left) <= kMaxWheelSpeedMps)) {
+      std::ostringstream why;
+      why << "omega_radps " << csv.cell("omega_radps") << " turns the wheels at " << right << " and " << left
+          << " m/s, beyond " << kMaxWheelSpeedMps << " m/s";
+      refuse("odom", csv.line(), "invalid_omega_radps", why.str());
       continue;
     }
     // (v, omega) held over [t_s, t_s + dt_s): the Odometry topic stamps the end of the interval.
-    // Intervals follow each other; 1 ms of overlap is rounding in the recording's stamps.
-    const StampNs end_ns = s_to_ns(t + dt);
-    if (previous_end != std::numeric_limits<StampNs>::min() &&
-        s_to_ns(t) < previous_end - kNsPerMillisecond) {
-      refuse("odom", csv.line(), "out_of_order_row", "interval starts before the previous one ends");
-      continue;
+    // Intervals follow each other; 1 ms of overlap is rounding in the recording's stamps. One
+    // sample per stamp: a second interval ending at the same stamp is a duplicate.
+    const StampNs start_ns = s_to_ns(t), end_ns = s_to_ns(t + dt);
+    if (previous_end != std::numeric_limits<StampNs>::min()) {
+      if (end_ns == previous_end) {
+        refuse("odom", csv.line(), "duplicate_row",
+               std::string(start_ns == previous_start ? "the same interval"
+                                                      : "an interval ending at the same stamp") +
+                   " as line " + std::to_string(previous_line));
+        continue;
+      }
+      if (end_ns < previous_end || start_ns < previous_end - kNsPerMillisecond) {
+        refuse("odom", csv.line(), "out_of_order_row", "interval starts before the previous one ends");
+        continue;
+      }
     }
+    previous_start = start_ns;
     previous_end = end_ns;
+    previous_line = csv.line();
     SourceEvent e;
     e.kind = SourceEvent::Kind::kOdometry;
     e.stamp_ns = end_ns;
     e.odometry.stamp_ns = end_ns;
     e.odometry.wheel_base_m = 2.0 * half_track;
-    e.odometry.wheel_velocity_right_mps = v + w * half_track;
-    e.odometry.wheel_velocity_left_mps = v - w * half_track;
+    e.odometry.wheel_velocity_right_mps = right;
+    e.odometry.wheel_velocity_left_mps = left;
     e.odometry.wheel_velocity_covariance.diagonal()
         << options_.odometry_k_v_m * std::abs(e.odometry.wheel_velocity_right_mps) / dt,
         options_.odometry_k_v_m * std::abs(e.odometry.wheel_velocity_left_mps) / dt;
@@ -112,20 +154,28 @@ void ReplaySource::load_ranges(const std::string& path) {
   const double c = speed_of_sound_mps(options_.reference_temperature_c);
   StampNs previous = std::numeric_limits<StampNs>::min();
   std::uint64_t sequence = 0;
+  // Each measurement once: the line of the range to each beacon at each stamp (one receiver).
+  std::map<std::pair<StampNs, std::uint32_t>, std::size_t> measured;
   while (csv.next()) {
     double t = 0, range = 0;
     std::uint32_t id = 0;
-    if (!csv.complete() || !parse_finite(csv.cell("t_s"), t) || !parse_id(csv.cell("beacon_id"), id) ||
-        !parse_finite(csv.cell("range_m"), range)) {
-      refuse("ranges", csv.line(), "malformed_row", "not t_s, an unsigned beacon id and a finite range");
+    std::string problem;
+    if (!complete(csv, "ranges") || !take(csv, "ranges", "t_s", t, 0.0, kMaxFileStampS)) continue;
+    if (csv.read_id("beacon_id", id, problem) != NumberError::kNone) {
+      refuse("ranges", csv.line(), "malformed_row", problem);
       continue;
     }
-    if (!stampable(t) || !stampable(range / c)) {
-      refuse("ranges", csv.line(), "invalid_value",
-             "t_s and the time of flight must lie within 4.6e9 s of 0");
-      continue;
-    }
+    // Negative ranges, and ranges beyond the decoder's limits, travel on: the decoder refuses and
+    // counts them. Beyond any beacon system's reach they are refused here.
+    if (!take(csv, "ranges", "range_m", range, -kMaxRangeM, kMaxRangeM)) continue;
     const StampNs arrival_ns = s_to_ns(t);
+    const auto [first, fresh] = measured.emplace(std::make_pair(arrival_ns, id), csv.line());
+    if (!fresh) {
+      refuse("ranges", csv.line(), "duplicate_row",
+             "a second range to beacon " + std::to_string(id) + " at t_s " + csv.cell("t_s") +
+                 " (first at line " + std::to_string(first->second) + "); the first is replayed");
+      continue;
+    }
     if (arrival_ns < previous && notes_.size() < 20) {
       // Each row carries its own stamp: the rows are replayed in stamp order, and this is said.
       notes_.push_back(directory_ + "/ranges.csv:" + std::to_string(csv.line()) + ": " +
@@ -133,7 +183,6 @@ void ReplaySource::load_ranges(const std::string& path) {
                        " s earlier than the row before; ranges are replayed in stamp order");
     }
     previous = std::max(previous, arrival_ns);
-    // Negative or absurd ranges travel on as they are: the decoder refuses and counts them.
     SourceEvent e;
     e.kind = SourceEvent::Kind::kTof;
     e.stamp_ns = arrival_ns;
@@ -153,23 +202,26 @@ void ReplaySource::load_truth(const std::string& path) {
   CsvReader csv = open(path, {"t_s", "x_m", "y_m"});
   truth_has_yaw_ = csv.has_column("yaw_rad");
   StampNs previous = std::numeric_limits<StampNs>::min();
+  std::size_t previous_line = 0;
   while (csv.next()) {
     double t = 0, x = 0, y = 0, yaw = 0.0;
-    if (!csv.complete() || !parse_finite(csv.cell("t_s"), t) || !parse_finite(csv.cell("x_m"), x) ||
-        !parse_finite(csv.cell("y_m"), y) || (truth_has_yaw_ && !parse_finite(csv.cell("yaw_rad"), yaw))) {
-      refuse("gt", csv.line(), "malformed_row", "not finite t_s, x_m, y_m[, yaw_rad]");
-      continue;
-    }
-    if (!stampable(t)) {
-      refuse("gt", csv.line(), "invalid_value", "t_s must lie within 4.6e9 s of 0");
+    if (!complete(csv, "gt") || !take(csv, "gt", "t_s", t, 0.0, kMaxFileStampS) ||
+        !take(csv, "gt", "x_m", x, -kMaxMapCoordinateM, kMaxMapCoordinateM) ||
+        !take(csv, "gt", "y_m", y, -kMaxMapCoordinateM, kMaxMapCoordinateM) ||
+        (truth_has_yaw_ && !take(csv, "gt", "yaw_rad", yaw, -kMaxAngleRad, kMaxAngleRad))) {
       continue;
     }
     const StampNs stamp = s_to_ns(t);
-    if (stamp <= previous) {
+    if (stamp == previous) {
+      refuse("gt", csv.line(), "duplicate_row", "the same t_s as line " + std::to_string(previous_line));
+      continue;
+    }
+    if (stamp < previous) {
       refuse("gt", csv.line(), "out_of_order_row", "not after the previous truth row");
       continue;
     }
     previous = stamp;
+    previous_line = csv.line();
     SourceEvent e;
     e.kind = SourceEvent::Kind::kTruth;
     e.stamp_ns = stamp;

@@ -2,8 +2,13 @@
 // Replays a recording in the common CSV layout of ../shared/datasets/*/replay/ (documented in
 // docs/replay-format.md): odom.csv (t_s, dt_s, v_mps, omega_radps), ranges.csv (t_s, beacon_id,
 // range_m), beacons.csv (beacon_id, x_m, y_m, z_m), optional gt.csv (t_s, x_m, y_m[, yaw_rad]).
-// Extra columns are allowed and ignored. A malformed or out-of-order row is skipped and
-// counted by reason (reported with its file and line); a missing file or header is an error.
+// Extra columns are allowed and ignored. A malformed, out-of-range, duplicate or out-of-order row
+// is skipped and counted by reason (reported with its file and line): "<file>.malformed_row" (a
+// cell short, a cell not a decimal number), "<file>.invalid_<column>" (a number outside its
+// column's range: stamps in [0, kMaxFileStampS], wheel speeds within kMaxWheelSpeedMps, ...,
+// core/limits.hpp), "<file>.duplicate_row" (a second range to a beacon at a stamp, a second
+// odometry interval or truth row at a stamp), "<file>.out_of_order_row". A missing file or header is
+// an error.
 // Ranges filed out of stamp order are replayed in stamp order (and said in load_notes()).
 #include <stdexcept>
 #include <string>
@@ -61,6 +66,12 @@ class ReplaySource final : public Source {
   void load_ranges(const std::string& path);
   void load_truth(const std::string& path);
   static CsvReader open(const std::string& path, const std::vector<std::string>& columns);
+  // The current row has every cell; else refused as <file>.malformed_row.
+  bool complete(const CsvReader& csv, const std::string& file);
+  // The row's `column` within [min, max]; else the row is refused (malformed_row when the cell is
+  // not a number, invalid_<column> when it lies outside) and false returned.
+  bool take(const CsvReader& csv, const std::string& file, const std::string& column, double& out, double min,
+            double max);
   void refuse(const std::string& file, std::size_t line, const std::string& reason,
               const std::string& detail);
 

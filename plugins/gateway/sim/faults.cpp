@@ -1,8 +1,10 @@
 #include "faults.hpp"
 
 #include <cmath>
-#include <cstdlib>
 #include <stdexcept>
+
+#include "beaconloc/core/decimal.hpp"
+#include "beaconloc/core/limits.hpp"
 
 namespace beaconloc::sim {
 
@@ -13,14 +15,20 @@ namespace {
                               " (forms: beacon_dies=ID@T, tof_outage=FROM:TO, echoes=P)");
 }
 
-// The whole of text as a finite number, or a refusal.
-double number(const std::string& spec, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
-    refuse(spec, "'" + text + "' is not a number");
-  }
+// The whole of text as a decimal number (core/decimal.hpp), or a refusal.
+template <class T>
+T number(const std::string& spec, const std::string& text, const char* what) {
+  T v{};
+  const NumberError e = parse_decimal(text, v);
+  if (e != NumberError::kNone) refuse(spec, number_problem(what, text, e));
   return v;
+}
+
+// A time of the run (s): within [0, kMaxDurationS].
+double time_s(const std::string& spec, const std::string& text, const char* what) {
+  const double t = number<double>(spec, text, what);
+  if (t < 0.0 || t > kMaxDurationS) refuse(spec, range_problem(what, t, 0.0, kMaxDurationS));
+  return t;
 }
 
 }  // namespace
@@ -33,11 +41,8 @@ void apply_fault(Scenario& scenario, const std::string& spec) {
   if (kind == "beacon_dies") {
     const auto at = value.find('@');
     if (at == std::string::npos) refuse(spec, "no '@'");
-    const double id = number(spec, value.substr(0, at));
-    const double t_s = number(spec, value.substr(at + 1));
-    if (id < 0 || id != std::floor(id) || id > 4294967294.0) refuse(spec, "the beacon id is not an id");
-    if (t_s < 0) refuse(spec, "the time is negative");
-    const auto beacon_id = static_cast<std::uint32_t>(id);
+    const auto beacon_id = number<std::uint32_t>(spec, value.substr(0, at), "the beacon id");
+    const double t_s = time_s(spec, value.substr(at + 1), "the time");
     bool known = false;
     for (const auto& b : scenario.beacons) known = known || b.id == beacon_id;
     if (!known) refuse(spec, "the scenario has no beacon " + std::to_string(beacon_id));
@@ -45,12 +50,12 @@ void apply_fault(Scenario& scenario, const std::string& spec) {
   } else if (kind == "tof_outage") {
     const auto colon = value.find(':');
     if (colon == std::string::npos) refuse(spec, "no ':'");
-    const double from_s = number(spec, value.substr(0, colon));
-    const double to_s = number(spec, value.substr(colon + 1));
-    if (from_s < 0 || !(to_s > from_s)) refuse(spec, "the outage must be 0 <= FROM < TO");
+    const double from_s = time_s(spec, value.substr(0, colon), "FROM");
+    const double to_s = time_s(spec, value.substr(colon + 1), "TO");
+    if (!(to_s > from_s)) refuse(spec, "the outage must be 0 <= FROM < TO");
     scenario.faults.tof_outages_ns.emplace_back(s_to_ns(from_s), s_to_ns(to_s));
   } else if (kind == "echoes") {
-    const double p = number(spec, value);
+    const double p = number<double>(spec, value, "the probability");
     if (p < 0.0 || p > 1.0) refuse(spec, "the probability is outside [0, 1]");
     scenario.echo.probability = p;
   } else {

@@ -7,6 +7,10 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <type_traits>
+
+#include "beaconloc/core/limits.hpp"
+#include "beaconloc/core/yaml_document.hpp"
 
 namespace beaconloc::sim {
 namespace {
@@ -39,12 +43,21 @@ class Section {
   }
   double number(const std::string& key, double fallback, double min, double max) const {
     const double v = get<double>(key, fallback);
+    within(join(key), v, min, max, node_[key] ? node_[key] : node_);
+    return v;
+  }
+  // A whole number: "count: 3.5" is refused, not truncated.
+  int integer(const std::string& key, int fallback, int min, int max) const {
+    const int v = get<int>(key, fallback);
+    within(join(key), v, min, max, node_[key] ? node_[key] : node_);
+    return v;
+  }
+  void within(const std::string& what, double v, double min, double max, const YAML::Node& at) const {
     if (!std::isfinite(v) || v < min || v > max) {
       std::ostringstream range;
       range << "must be in [" << min << ", " << max << "], got " << v;
-      fail(join(key), range.str(), node_[key] ? node_[key] : node_);
+      fail(what, range.str(), at);
     }
-    return v;
   }
   Section child(const std::string& key, std::set<std::string> allowed) const {
     return Section(node_[key], join(key), origin_, std::move(allowed));
@@ -63,13 +76,35 @@ class Section {
     throw ScenarioError(msg.str());
   }
 
+  // Numbers, and lists of numbers, through the project's one decimal parser; other types
+  // (names, booleans) through yaml-cpp.
   template <class T>
   T as(const YAML::Node& n, const std::string& what) const {
-    try {
-      return n.as<T>();
-    } catch (const YAML::Exception&) {
-      fail(what, "has the wrong type", n);
+    if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
+      return scalar_number<T>(n, what);
+    } else if constexpr (std::is_same_v<T, std::vector<double>> ||
+                         std::is_same_v<T, std::vector<std::uint32_t>>) {
+      if (!n.IsSequence()) fail(what, "has the wrong type", n);
+      T out;
+      for (std::size_t i = 0; i < n.size(); ++i) {
+        out.push_back(scalar_number<typename T::value_type>(n[i], what + "[" + std::to_string(i) + "]"));
+      }
+      return out;
+    } else {
+      try {
+        return n.as<T>();
+      } catch (const YAML::Exception&) {
+        fail(what, "has the wrong type", n);
+      }
     }
+  }
+  template <class T>
+  T scalar_number(const YAML::Node& n, const std::string& what) const {
+    if (!n.IsScalar()) fail(what, "has the wrong type", n);
+    T v{};
+    const NumberError e = yaml_number(n, v);
+    if (e != NumberError::kNone) fail(what, std::string(describe(e)) + " ('" + n.Scalar() + "')", n);
+    return v;
   }
 
  private:
@@ -78,17 +113,19 @@ class Section {
   std::string origin_;
 };
 
-Eigen::Vector2d vec2(const Section& s, const YAML::Node& n, const std::string& what) {
+// [x, y], each within [-limit, limit].
+Eigen::Vector2d vec2(const Section& s, const YAML::Node& n, const std::string& what, double limit) {
   const auto v = s.as<std::vector<double>>(n, what);
-  if (v.size() != 2 || !std::isfinite(v[0]) || !std::isfinite(v[1])) s.fail(what, "must be [x, y]", n);
+  if (v.size() != 2) s.fail(what, "must be [x, y]", n);
+  for (std::size_t i = 0; i < 2; ++i) s.within(what + "[" + std::to_string(i) + "]", v[i], -limit, limit, n);
   return {v[0], v[1]};
 }
 
-Eigen::Vector3d vec3(const Section& s, const YAML::Node& n, const std::string& what) {
+// Three numbers, each within [-limit, limit].
+Eigen::Vector3d vec3(const Section& s, const YAML::Node& n, const std::string& what, double limit) {
   const auto v = s.as<std::vector<double>>(n, what);
-  if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
-    s.fail(what, "must be three finite numbers", n);
-  }
+  if (v.size() != 3) s.fail(what, "must be three finite numbers", n);
+  for (std::size_t i = 0; i < 3; ++i) s.within(what + "[" + std::to_string(i) + "]", v[i], -limit, limit, n);
   return {v[0], v[1], v[2]};
 }
 
@@ -111,7 +148,7 @@ void read_beacons(const Section& root, Scenario& sc) {
       b.fail(b.join("id"), "is reserved for unidentified pulses", list[i]);
     if (!ids.insert(beacon.id).second) b.fail(b.join("id"), "repeats an earlier beacon id", list[i]);
     if (!b.has("position_m")) b.fail(b.join("position_m"), "is required", list[i]);
-    beacon.position_map_m = vec3(b, b.node("position_m"), b.join("position_m"));
+    beacon.position_map_m = vec3(b, b.node("position_m"), b.join("position_m"), kMaxMapCoordinateM);
     beacon.group = b.get<std::uint32_t>("group", 0);
     sc.beacons.push_back(beacon);
   }
@@ -141,8 +178,8 @@ void read_beacon_system(const Section& root, Scenario& sc) {
   if (s.has("marked_beacon_id")) sc.marked_beacon_id = s.get<std::uint32_t>("marked_beacon_id", 0);
   sc.range_sigma_m = s.number("range_sigma_m", 0.01, 0.0, 100.0);
   sc.tof_sigma_s = s.number("tof_sigma_s", 0.0, 0.0, 1.0);
-  sc.min_range_m = s.number("min_range_m", 0.0, 0.0, 1e4);
-  sc.max_range_m = s.number("max_range_m", 5.0, 0.0, 1e4);
+  sc.min_range_m = s.number("min_range_m", 0.0, 0.0, kMaxRangeM);
+  sc.max_range_m = s.number("max_range_m", 5.0, 0.0, kMaxRangeM);
   if (sc.max_range_m <= sc.min_range_m)
     s.fail(s.join("max_range_m"), "must exceed min_range_m", s.node("max_range_m"));
   sc.beam_half_angle_rad = s.number("beam_half_angle_deg", 90.0, 0.1, 180.0) * M_PI / 180.0;
@@ -160,7 +197,7 @@ void read_beacon_system(const Section& root, Scenario& sc) {
 void read_robot(const Section& root, Scenario& sc) {
   if (!root.has("robot")) root.fail("robot", "is required", root.node("robot"));
   const Section r = root.child("robot", {"wheel_base_m", "receivers", "odometry"});
-  sc.wheel_base_m = r.number("wheel_base_m", 0.33, 0.01, 10.0);
+  sc.wheel_base_m = r.number("wheel_base_m", 0.33, 0.01, kMaxWheelBaseM);
   if (!r.has("receivers")) r.fail(r.join("receivers"), "is required", r.node("receivers"));
   const Section rx = r.child("receivers", {"height_m", "positions_m", "circle"});
   if (rx.has("positions_m") == rx.has("circle")) {
@@ -168,18 +205,18 @@ void read_robot(const Section& root, Scenario& sc) {
   }
   if (rx.has("circle")) {
     const Section c = rx.child("circle", {"radius_m", "count"});
-    sc.receivers = ReceiverArray::on_circle(c.number("radius_m", 0.19, 0.0, 10.0),
-                                            static_cast<int>(c.number("count", 3, 1, 16)));
+    sc.receivers = ReceiverArray::on_circle(c.number("radius_m", 0.19, 0.0, kMaxReceiverOffsetM),
+                                            c.integer("count", 3, 1, 16));
   } else {
     const YAML::Node list = rx.node("positions_m");
     if (!list.IsSequence() || list.size() == 0) rx.fail(rx.join("positions_m"), "must list receivers", list);
     sc.receivers.receivers_base_m.clear();
     for (std::size_t i = 0; i < list.size(); ++i) {
       sc.receivers.receivers_base_m.push_back(
-          vec2(rx, list[i], rx.join("positions_m") + "[" + std::to_string(i) + "]"));
+          vec2(rx, list[i], rx.join("positions_m") + "[" + std::to_string(i) + "]", kMaxReceiverOffsetM));
     }
   }
-  sc.receivers.receiver_height_m = rx.number("height_m", 0.0, -10.0, 10.0);
+  sc.receivers.receiver_height_m = rx.number("height_m", 0.0, -kMaxReceiverOffsetM, kMaxReceiverOffsetM);
   if (r.has("odometry")) {
     const Section o = r.child("odometry", {"period_s", "k_v_m", "alpha", "wheel_radius_error_right",
                                            "wheel_radius_error_left", "wheel_base_error"});
@@ -216,13 +253,14 @@ void read_trajectory(const Section& root, Scenario& sc) {
       const Section s(list[i], t.join("segments") + "[" + std::to_string(i) + "]", root.origin(),
                       {"duration_s", "linear_mps", "angular_radps"});
       if (!s.has("duration_s")) s.fail(s.join("duration_s"), "is required", list[i]);
-      segments.push_back({s.number("duration_s", 0.0, 1e-6, 1e5), s.number("linear_mps", 0.0, -10.0, 10.0),
+      segments.push_back({s.number("duration_s", 0.0, 1e-6, 1e5),
+                          s.number("linear_mps", 0.0, -kMaxWheelSpeedMps, kMaxWheelSpeedMps),
                           s.number("angular_radps", 0.0, -10.0, 10.0)});
     }
     if (!t.has("start_pose"))
       t.fail(t.join("start_pose"), "is required with segments", root.node("trajectory"));
-    sc.trajectory =
-        Trajectory(vec3(t, t.node("start_pose"), t.join("start_pose")), segments, t.get<bool>("loop", false));
+    sc.trajectory = Trajectory(vec3(t, t.node("start_pose"), t.join("start_pose"), kMaxMapCoordinateM),
+                               segments, t.get<bool>("loop", false));
     // The simulator composes a lap once per lap travelled, counted as an int: a bounded number.
     if (sc.trajectory.loops() && sc.duration_s / sc.trajectory.period_s() > 1e6)
       t.fail(t.join("loop"), "would repeat the segments more than 1e6 times in duration_s", t.node("loop"));
@@ -235,12 +273,13 @@ void read_trajectory(const Section& root, Scenario& sc) {
   const YAML::Node list = t.node("waypoints_m");
   std::vector<Eigen::Vector2d> waypoints;
   for (std::size_t i = 0; list.IsSequence() && i < list.size(); ++i) {
-    waypoints.push_back(vec2(t, list[i], t.join("waypoints_m") + "[" + std::to_string(i) + "]"));
+    waypoints.push_back(
+        vec2(t, list[i], t.join("waypoints_m") + "[" + std::to_string(i) + "]", kMaxMapCoordinateM));
   }
   if (!t.has("speed_mps"))
     t.fail(t.join("speed_mps"), "is required with waypoints_m", root.node("trajectory"));
   try {
-    sc.trajectory = Trajectory::from_waypoints(waypoints, t.number("speed_mps", 0.0, 1e-3, 10.0),
+    sc.trajectory = Trajectory::from_waypoints(waypoints, t.number("speed_mps", 0.0, 1e-3, kMaxWheelSpeedMps),
                                                t.number("turn_rate_radps", 0.5, 1e-3, 10.0));
   } catch (const std::invalid_argument& e) {
     t.fail(t.join("waypoints_m"), e.what(), list);
@@ -251,14 +290,20 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
   if (root.has("map")) {
     const Section m = root.child(
         "map", {"resolution_m", "origin_m", "size_m", "border", "obstacles", "unmapped_obstacles"});
-    const double res = m.number("resolution_m", 0.1, 0.005, 10.0);
+    const double res =
+        m.number("resolution_m", 0.1, OccupancyGrid::kMinResolutionM, OccupancyGrid::kMaxResolutionM);
     if (!m.has("size_m")) m.fail(m.join("size_m"), "is required", root.node("map"));
-    const Eigen::Vector2d size = vec2(m, m.node("size_m"), m.join("size_m"));
-    if (size.minCoeff() <= 0.0 || size.maxCoeff() / res > 20000 || (size.x() / res) * (size.y() / res) > 1e8)
-      m.fail(m.join("size_m"), "must be positive and at most 20000 cells a side, 1e8 cells in all",
-             m.node("size_m"));
-    const Eigen::Vector2d origin =
-        m.has("origin_m") ? vec2(m, m.node("origin_m"), m.join("origin_m")) : Eigen::Vector2d::Zero();
+    const Eigen::Vector2d size = vec2(m, m.node("size_m"), m.join("size_m"), kMaxMapCoordinateM);
+    if (size.minCoeff() <= 0.0 || size.maxCoeff() / res > OccupancyGrid::kMaxCellsPerSide ||
+        (size.x() / res) * (size.y() / res) > static_cast<double>(OccupancyGrid::kMaxCells)) {
+      std::ostringstream limits;
+      limits << "must be positive and at most " << OccupancyGrid::kMaxCellsPerSide << " cells a side, "
+             << OccupancyGrid::kMaxCells << " cells in all";
+      m.fail(m.join("size_m"), limits.str(), m.node("size_m"));
+    }
+    const Eigen::Vector2d origin = m.has("origin_m")
+                                       ? vec2(m, m.node("origin_m"), m.join("origin_m"), kMaxMapCoordinateM)
+                                       : Eigen::Vector2d::Zero();
     const int width = static_cast<int>(std::ceil(size.x() / res - 1e-9));
     const int height = static_cast<int>(std::ceil(size.y() / res - 1e-9));
     if (width < 1 || height < 1)
@@ -271,8 +316,8 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
         const Section o(list[i], m.join(key) + "[" + std::to_string(i) + "]", root.origin(),
                         {"min_m", "max_m"});
         if (!o.has("min_m") || !o.has("max_m")) o.fail(o.join("min_m"), "and max_m are required", list[i]);
-        const Eigen::Vector2d lo = vec2(o, o.node("min_m"), o.join("min_m")),
-                              hi = vec2(o, o.node("max_m"), o.join("max_m"));
+        const Eigen::Vector2d lo = vec2(o, o.node("min_m"), o.join("min_m"), kMaxMapCoordinateM),
+                              hi = vec2(o, o.node("max_m"), o.join("max_m"), kMaxMapCoordinateM);
         if ((hi.array() <= lo.array()).any()) o.fail(o.join("max_m"), "must exceed min_m", list[i]);
         target.fill_rectangle(lo, hi);
       }
@@ -290,12 +335,13 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
     const Section l =
         root.child("laser", {"beams", "fov_deg", "period_s", "range_sigma_m", "max_range_m", "mount_m"});
     LaserModel laser;
-    laser.beams = static_cast<int>(l.number("beams", 19, 1, 4096));
+    laser.beams = l.integer("beams", 19, 1, 4096);
     laser.fov_rad = l.number("fov_deg", 180.0, 0.0, 360.0) * M_PI / 180.0;
     laser.period_ns = duration_ns(l, "period_s", 0.022);
     laser.range_sigma_m = l.number("range_sigma_m", 0.1, 0.0, 10.0);
     laser.max_range_m = l.number("max_range_m", 8.0, 0.01, 1e3);
-    if (l.has("mount_m")) laser.mount_base = vec3(l, l.node("mount_m"), l.join("mount_m"));
+    if (l.has("mount_m"))
+      laser.mount_base = vec3(l, l.node("mount_m"), l.join("mount_m"), kMaxReceiverOffsetM);
     sc.laser = laser;
   }
 }
@@ -305,9 +351,9 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
 Scenario parse_scenario(const std::string& yaml_text, const std::string& origin) {
   YAML::Node doc;
   try {
-    doc = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw ScenarioError(origin + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+    doc = load_yaml(yaml_text, origin);
+  } catch (const YamlError& e) {
+    throw ScenarioError(e.what());
   }
   const Section root(doc, "", origin,
                      {"name", "description", "seed", "duration_s", "beacons", "beacon_system", "robot",
@@ -316,7 +362,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
   sc.name = root.required<std::string>("name");
   sc.description = root.get<std::string>("description", "");
   sc.seed = root.get<std::uint64_t>("seed", 1);
-  sc.duration_s = root.number("duration_s", 20.0, 0.01, 1e6);
+  sc.duration_s = root.number("duration_s", 20.0, 0.01, kMaxDurationS);
   read_beacons(root, sc);
   read_beacon_system(root, sc);
   read_robot(root, sc);

@@ -1,7 +1,8 @@
 #pragma once
 // Loads a scenario from YAML (schema: examples/scenarios/README.md). Strict: an unknown key, a
-// missing required key, a wrong type or an out-of-range value is a ScenarioError naming the
-// file, the key and its line.
+// key given twice, a missing required key, a wrong type, a number that is not decimal
+// (core/decimal.hpp) or an out-of-range value is a ScenarioError naming the file, the key and
+// its line (core/yaml_document.hpp loads the file).
 #include <stdexcept>
 #include <string>
 

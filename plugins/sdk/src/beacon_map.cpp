@@ -44,7 +44,7 @@ BeaconMapCheck check_beacons(const std::vector<Beacon>& beacons) {
     if (b.id == kBeaconUnidentified) return {BeaconMapProblem::kReservedId, b.id};
     if (!ids.insert(b.id).second) return {BeaconMapProblem::kDuplicateId, b.id};
     if (!b.position_map_m.allFinite()) return {BeaconMapProblem::kNonFinitePosition, b.id};
-    if (b.position_map_m.cwiseAbs().maxCoeff() > kMaxBeaconCoordinateM)
+    if (b.position_map_m.cwiseAbs().maxCoeff() > kMaxMapCoordinateM)
       return {BeaconMapProblem::kPositionOutOfRange, b.id};
   }
   return {};

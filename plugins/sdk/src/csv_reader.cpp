@@ -1,11 +1,11 @@
 #include "beaconloc/core/csv_reader.hpp"
 
-#include <cerrno>
-#include <cmath>
-#include <cstdlib>
 #include <iomanip>
+#include <limits>
 #include <set>
 #include <sstream>
+
+#include "beaconloc/core/limits.hpp"
 
 namespace beaconloc {
 namespace {
@@ -26,28 +26,18 @@ std::vector<std::string> split_csv_line(const std::string& line) {
   return out;
 }
 
-bool parse_finite(const std::string& cell, double& out) {
-  if (cell.empty()) return false;
-  errno = 0;
-  char* end = nullptr;
-  out = std::strtod(cell.c_str(), &end);
-  return errno == 0 && end == cell.c_str() + cell.size() && std::isfinite(out);
-}
-
-bool parse_id(const std::string& cell, std::uint32_t& out) {
-  double v = 0.0;
-  if (!parse_finite(cell, v) || v < 0.0 || v >= 4294967295.0 || v != std::floor(v)) return false;
-  out = static_cast<std::uint32_t>(v);
-  return true;
-}
-
 CsvReader::CsvReader(const std::string& path, const std::vector<std::string>& required)
     : path_(path), in_(path) {
   if (!in_) throw CsvError("cannot read '" + path + "'");
   std::string header;
   if (!std::getline(in_, header)) throw CsvError(path + ":1: empty file, expected a header row");
+  const std::string bom = "\xEF\xBB\xBF";
+  if (header.compare(0, bom.size(), bom) == 0) header.erase(0, bom.size());
   const auto names = split_csv_line(strip(header));
-  for (std::size_t i = 0; i < names.size(); ++i) columns_[names[i]] = i;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (!columns_.emplace(names[i], i).second)
+      throw CsvError(path + ":1: header names column '" + names[i] + "' twice");
+  }
   for (const auto& r : required) {
     if (!columns_.count(r)) throw CsvError(path + ":1: header lacks column '" + r + "'");
   }
@@ -66,6 +56,42 @@ bool CsvReader::next() {
   return false;
 }
 
+NumberError CsvReader::read(const std::string& column, double& out, double min, double max,
+                            std::string& problem) const {
+  const std::string& text = cell(column);
+  NumberError e = parse_decimal(text, out);
+  if (e != NumberError::kNone) {
+    problem = number_problem(column, text, e);
+  } else if (!(out >= min && out <= max)) {
+    e = NumberError::kOutOfRange;
+    problem = range_problem(column, out, min, max);
+  }
+  return e;
+}
+
+NumberError CsvReader::read(const std::string& column, std::int64_t& out, std::int64_t min, std::int64_t max,
+                            std::string& problem) const {
+  const std::string& text = cell(column);
+  NumberError e = parse_decimal(text, out);
+  if (e != NumberError::kNone) {
+    problem = number_problem(column, text, e);
+  } else if (out < min || out > max) {
+    e = NumberError::kOutOfRange;
+    problem = column + " " + text + " is outside [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  }
+  return e;
+}
+
+NumberError CsvReader::read_id(const std::string& column, std::uint32_t& out, std::string& problem) const {
+  const std::string& text = cell(column);
+  NumberError e = parse_decimal(text, out);
+  if (e == NumberError::kNone && out == std::numeric_limits<std::uint32_t>::max()) {
+    e = NumberError::kOutOfRange;  // the id of unidentified pulses
+  }
+  if (e != NumberError::kNone) problem = number_problem(column, text, e) + " (an id in 0..4294967294)";
+  return e;
+}
+
 BeaconMap load_beacon_map_csv(const std::string& path) {
   CsvReader csv(path, {"beacon_id", "x_m", "y_m", "z_m"});
   std::vector<Beacon> beacons;
@@ -73,9 +99,13 @@ BeaconMap load_beacon_map_csv(const std::string& path) {
   while (csv.next()) {
     Beacon b;
     double x = 0, y = 0, z = 0;
-    if (!csv.complete() || !parse_id(csv.cell("beacon_id"), b.id) || !parse_finite(csv.cell("x_m"), x) ||
-        !parse_finite(csv.cell("y_m"), y) || !parse_finite(csv.cell("z_m"), z)) {
-      throw CsvError(csv.where() + ": malformed beacon row");
+    std::string problem;
+    if (!csv.complete()) throw CsvError(csv.where() + ": malformed beacon row: " + csv.cell_count_problem());
+    if (csv.read_id("beacon_id", b.id, problem) != NumberError::kNone ||
+        csv.read("x_m", x, -kMaxMapCoordinateM, kMaxMapCoordinateM, problem) != NumberError::kNone ||
+        csv.read("y_m", y, -kMaxMapCoordinateM, kMaxMapCoordinateM, problem) != NumberError::kNone ||
+        csv.read("z_m", z, -kMaxMapCoordinateM, kMaxMapCoordinateM, problem) != NumberError::kNone) {
+      throw CsvError(csv.where() + ": malformed beacon row: " + problem);
     }
     if (!ids.insert(b.id).second)
       throw CsvError(csv.where() + ": beacon id " + std::to_string(b.id) + " repeated");

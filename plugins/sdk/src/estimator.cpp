@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "beaconloc/core/decimal.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/limits.hpp"
 
@@ -40,10 +41,10 @@ std::map<std::string, double> parse_estimator_parameters(const std::vector<std::
       throw std::invalid_argument(option_name + " '" + item + "' is not NAME=VALUE");
     }
     const std::string value = item.substr(eq + 1);
-    char* end = nullptr;
-    const double v = std::strtod(value.c_str(), &end);
-    if (value.empty() || end != value.c_str() + value.size() || !std::isfinite(v)) {
-      throw std::invalid_argument(option_name + " '" + item + "': '" + value + "' is not a number");
+    double v = 0.0;
+    const NumberError e = parse_decimal(value, v);
+    if (e != NumberError::kNone) {
+      throw std::invalid_argument(option_name + " '" + item + "': " + number_problem("the value", value, e));
     }
     if (!out.emplace(item.substr(0, eq), v).second) {
       throw std::invalid_argument(option_name + " '" + item + "': " + item.substr(0, eq) + " is given twice");
@@ -163,10 +164,10 @@ InputResult check_initial_pose(const Pose2& pose, const Cov3& c) {
       Eigen::LLT<Cov3>(c).info() != Eigen::Success) {
     return InputResult::rejected("invalid_initial_pose");
   }
-  // Where no beacon can be (core/beacon_map.hpp's bound), or a standard deviation beyond it:
+  // Beyond any site (core/limits.hpp), or a standard deviation beyond it:
   // no place to start from.
-  if (pose.head<2>().cwiseAbs().maxCoeff() > kMaxBeaconCoordinateM ||
-      c.diagonal().maxCoeff() > kMaxBeaconCoordinateM * kMaxBeaconCoordinateM) {
+  if (pose.head<2>().cwiseAbs().maxCoeff() > kMaxMapCoordinateM ||
+      c.diagonal().maxCoeff() > kMaxMapCoordinateM * kMaxMapCoordinateM) {
     return InputResult::rejected("implausible_initial_pose");
   }
   return InputResult::ok();

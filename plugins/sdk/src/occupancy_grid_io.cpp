@@ -1,13 +1,15 @@
 #include "beaconloc/core/occupancy_grid_io.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <vector>
+
+#include "beaconloc/core/limits.hpp"
+#include "beaconloc/core/yaml_document.hpp"
 
 namespace beaconloc {
 namespace {
@@ -15,6 +17,16 @@ namespace {
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
   throw MapFileError(path + ": " + what);
 }
+
+// "path:line: what", the line of the node the complaint is about.
+[[noreturn]] void fail_at(const std::string& path, const YAML::Node& at, const std::string& what) {
+  const YAML::Mark mark = at.Mark();
+  fail(mark.line >= 0 ? path + ":" + std::to_string(mark.line + 1) : path, what);
+}
+
+// The keys of a map_server YAML file (ROS 2 nav2 map_server, map_io).
+const std::set<std::string> kMapKeys = {"image",           "resolution",  "origin", "negate",
+                                        "occupied_thresh", "free_thresh", "mode"};
 
 // The next PGM header token, skipping whitespace and '#' comments.
 std::string header_token(std::istream& in, const std::string& path) {
@@ -34,28 +46,24 @@ std::string header_token(std::istream& in, const std::string& path) {
   return token;
 }
 
-int header_number(std::istream& in, const std::string& path, const char* what) {
+int header_number(std::istream& in, const std::string& path, const char* what, int max) {
   const std::string token = header_token(in, path);
-  std::size_t used = 0;
   int value = 0;
-  try {
-    value = std::stoi(token, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != token.size() || value <= 0) fail(path, std::string("bad PGM ") + what + " '" + token + "'");
+  const NumberError e = parse_decimal(token, value);
+  if (e != NumberError::kNone) fail(path, number_problem(std::string("PGM ") + what, token, e));
+  if (value < 1 || value > max) fail(path, range_problem(std::string("PGM ") + what, value, 1, max));
   return value;
 }
 
-double number(const YAML::Node& root, const char* key, const std::string& path) {
-  if (!root[key]) fail(path, std::string("missing '") + key + "'");
-  try {
-    const double v = root[key].as<double>();
-    if (!std::isfinite(v)) fail(path, std::string("'") + key + "' is not finite");
-    return v;
-  } catch (const YAML::Exception&) {
-    fail(path, std::string("'") + key + "' is not a number");
-  }
+// A number of the YAML file: a decimal scalar (core/decimal.hpp) within [min, max].
+double number(const YAML::Node& node, const std::string& key, const std::string& path, double min,
+              double max) {
+  if (!node.IsScalar()) fail_at(path, node, "'" + key + "' must be a number");
+  double v = 0.0;
+  const NumberError e = yaml_number(node, v);
+  if (e != NumberError::kNone) fail_at(path, node, number_problem(key, node.Scalar(), e));
+  if (!(v >= min && v <= max)) fail_at(path, node, range_problem(key, v, min, max));
+  return v;
 }
 
 // What the YAML file says, checked.
@@ -65,52 +73,57 @@ struct MapYaml {
   double origin_x = 0.0;
   double origin_y = 0.0;
   double occupied_thresh = 0.65;
+  double free_thresh = 0.196;
   bool negate = false;
 };
 
-MapYaml read_map_yaml(const YAML::Node& root, const std::string& yaml_path) {
+MapYaml read_map_yaml(const YAML::Node& root, const std::string& path) {
   MapYaml map;
-  if (!root.IsMap() || !root["image"]) fail(yaml_path, "missing 'image'");
-  map.resolution = number(root, "resolution", yaml_path);
-  if (!(map.resolution > 0.0)) fail(yaml_path, "'resolution' must be positive");
-  const YAML::Node origin = root["origin"];
-  if (!origin || !origin.IsSequence() || origin.size() != 3) fail(yaml_path, "'origin' must be [x, y, yaw]");
-  double oyaw = 0.0;
-  try {
-    map.origin_x = origin[0].as<double>();
-    map.origin_y = origin[1].as<double>();
-    oyaw = origin[2].as<double>();
-  } catch (const YAML::Exception&) {
-    fail(yaml_path, "'origin' must hold three numbers");
-  }
-  if (!std::isfinite(map.origin_x) || !std::isfinite(map.origin_y) || oyaw != 0.0) {
-    fail(yaml_path, "'origin' must be finite with yaw 0 (rotated maps are not supported)");
-  }
-  map.occupied_thresh = root["occupied_thresh"] ? number(root, "occupied_thresh", yaml_path) : 0.65;
-  if (!(map.occupied_thresh >= 0.0 && map.occupied_thresh <= 1.0))
-    fail(yaml_path, "'occupied_thresh' must be in [0, 1]");
-  if (root["free_thresh"]) {
-    const double free_thresh = number(root, "free_thresh", yaml_path);
-    if (!(free_thresh >= 0.0 && free_thresh <= 1.0)) fail(yaml_path, "'free_thresh' must be in [0, 1]");
-  }
-  if (root["negate"]) {
-    try {
-      map.negate = root["negate"].as<int>() != 0;
-    } catch (const YAML::Exception&) {
-      try {
-        map.negate = root["negate"].as<bool>();
-      } catch (const YAML::Exception&) {
-        fail(yaml_path, "'negate' must be 0 or 1");
-      }
+  if (!root.IsMap()) fail(path, "not a map file: a mapping of image, resolution, origin, ...");
+  for (const auto& kv : root) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string();
+    if (!kMapKeys.count(key)) {
+      fail_at(path, kv.first,
+              "'" + key +
+                  "' is not a map file key (image, resolution, origin, negate, occupied_thresh, "
+                  "free_thresh, mode)");
     }
   }
-  if (root["mode"] && root["mode"].as<std::string>("") != "trinary") {
-    fail(yaml_path, "only 'mode: trinary' (the default) is supported");
+  if (!root["image"]) fail(path, "missing 'image'");
+  if (!root["image"].IsScalar() || root["image"].Scalar().empty())
+    fail_at(path, root["image"], "'image' must be a file name");
+  map.image = root["image"].Scalar();
+  if (!root["resolution"]) fail(path, "missing 'resolution'");
+  map.resolution = number(root["resolution"], "resolution", path, OccupancyGrid::kMinResolutionM,
+                          OccupancyGrid::kMaxResolutionM);
+  const YAML::Node origin = root["origin"];
+  if (!origin) fail(path, "missing 'origin'");
+  if (!origin.IsSequence() || origin.size() != 3) fail_at(path, origin, "'origin' must be [x, y, yaw]");
+  map.origin_x = number(origin[0], "origin[0]", path, -kMaxMapCoordinateM, kMaxMapCoordinateM);
+  map.origin_y = number(origin[1], "origin[1]", path, -kMaxMapCoordinateM, kMaxMapCoordinateM);
+  if (number(origin[2], "origin[2]", path, -kMaxMapCoordinateM, kMaxMapCoordinateM) != 0.0)
+    fail_at(path, origin[2], "'origin' yaw must be 0 (rotated maps are not supported)");
+  if (root["occupied_thresh"])
+    map.occupied_thresh = number(root["occupied_thresh"], "occupied_thresh", path, 0.0, 1.0);
+  if (root["free_thresh"]) map.free_thresh = number(root["free_thresh"], "free_thresh", path, 0.0, 1.0);
+  if (map.free_thresh > map.occupied_thresh)
+    fail(path, "free_thresh must not exceed occupied_thresh (" + std::to_string(map.free_thresh) + " > " +
+                   std::to_string(map.occupied_thresh) + ")");
+  if (const YAML::Node negate = root["negate"]) {
+    // map_server writes 0 or 1; a YAML boolean says the same.
+    const std::string v = negate.IsScalar() ? negate.Scalar() : std::string();
+    bool as_bool = false;
+    if (v == "0" || v == "1") {
+      map.negate = v == "1";
+    } else if (YAML::convert<bool>::decode(negate, as_bool)) {
+      map.negate = as_bool;
+    } else {
+      fail_at(path, negate, "'negate' must be 0 or 1, not '" + v + "'");
+    }
   }
-  try {
-    map.image = root["image"].as<std::string>();
-  } catch (const YAML::Exception&) {
-    fail(yaml_path, "'image' must be a file name");
+  if (const YAML::Node mode = root["mode"]) {
+    if (!mode.IsScalar() || mode.Scalar() != "trinary")
+      fail_at(path, mode, "only 'mode: trinary' (the default) is supported");
   }
   return map;
 }
@@ -119,22 +132,28 @@ MapYaml read_map_yaml(const YAML::Node& root, const std::string& yaml_path) {
 OccupancyGrid read_pgm(std::istream& in, const MapYaml& map, const std::string& image_path) {
   const std::string magic = header_token(in, image_path);
   if (magic != "P5" && magic != "P2") fail(image_path, "not a PGM image (P5 or P2)");
-  const int width = header_number(in, image_path, "width");
-  const int height = header_number(in, image_path, "height");
-  const int max_value = header_number(in, image_path, "maximum value");
-  if (max_value > 255) fail(image_path, "16-bit PGM is not supported");
+  const int width = header_number(in, image_path, "width", OccupancyGrid::kMaxCellsPerSide);
+  const int height = header_number(in, image_path, "height", OccupancyGrid::kMaxCellsPerSide);
   const std::size_t cells = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  if (magic == "P5") {  // the data must be there before anything is allocated for it
+  if (static_cast<std::int64_t>(cells) > OccupancyGrid::kMaxCells) {
+    std::ostringstream why;
+    why << "PGM of " << width << " x " << height << " pixels: more than " << OccupancyGrid::kMaxCells;
+    fail(image_path, why.str());
+  }
+  const int max_value = header_number(in, image_path, "maximum value", 65535);
+  if (max_value > 255) fail(image_path, "16-bit PGM is not supported");
+  std::vector<int> pixels;
+  if (magic == "P5") {  // the data must be there before anything is allocated for it, and no more
     const auto here = in.tellg();
     in.seekg(0, std::ios::end);
     const auto size = in.tellg();
     in.seekg(here);
-    if (size - here < static_cast<std::streamoff>(cells)) fail(image_path, "truncated PGM data");
-  } else if (cells > 100'000'000) {
-    fail(image_path, "more than 1e8 cells in a text PGM");
-  }
-  std::vector<int> pixels;
-  if (magic == "P5") {
+    const auto data = static_cast<std::size_t>(size - here);
+    if (data < cells) fail(image_path, "truncated PGM data");
+    if (data > cells) {
+      fail(image_path, std::to_string(data - cells) + " bytes after the image's " + std::to_string(cells) +
+                           " pixels (one image per file)");
+    }
     pixels.resize(cells);
     std::vector<unsigned char> raw(pixels.size());
     in.read(reinterpret_cast<char*>(raw.data()), static_cast<std::streamsize>(raw.size()));
@@ -145,11 +164,14 @@ OccupancyGrid read_pgm(std::istream& in, const MapYaml& map, const std::string& 
     }
   } else {  // pixel by pixel: a header's size alone allocates nothing (4e8 bytes for 20 bytes of text)
     pixels.reserve(std::min<std::size_t>(cells, 1 << 16));
+    std::string token;
     for (std::size_t i = 0; i < cells; ++i) {
       int p = 0;
-      if (!(in >> p) || p < 0 || p > max_value) fail(image_path, "bad or truncated PGM data");
+      if (!(in >> token) || parse_decimal(token, p) != NumberError::kNone || p < 0 || p > max_value)
+        fail(image_path, "bad or truncated PGM data");
       pixels.push_back(p);
     }
+    if (in >> token) fail(image_path, "data after the image's " + std::to_string(cells) + " pixels");
   }
   OccupancyGrid grid({map.origin_x, map.origin_y}, map.resolution, width, height);
   for (int row = 0; row < height; ++row) {
@@ -162,15 +184,22 @@ OccupancyGrid read_pgm(std::istream& in, const MapYaml& map, const std::string& 
   return grid;
 }
 
+YAML::Node load_map_yaml(const std::string& text, const std::string& origin) {
+  try {
+    return load_yaml(text, origin);
+  } catch (const YamlError& e) {
+    throw MapFileError(e.what());
+  }
+}
+
 }  // namespace
 
 OccupancyGrid load_occupancy_grid(const std::string& yaml_path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(yaml_path);
-  } catch (const YAML::Exception& e) {
-    fail(yaml_path, std::string("not a readable YAML map: ") + e.what());
-  }
+  std::ifstream file(yaml_path);
+  if (!file) fail(yaml_path, "cannot read the map file");
+  std::stringstream text;
+  text << file.rdbuf();
+  const YAML::Node root = load_map_yaml(text.str(), yaml_path);
   const MapYaml map = read_map_yaml(root, yaml_path);
   std::filesystem::path image = map.image;
   if (image.is_relative()) image = std::filesystem::path(yaml_path).parent_path() / image;
@@ -181,12 +210,7 @@ OccupancyGrid load_occupancy_grid(const std::string& yaml_path) {
 
 OccupancyGrid parse_occupancy_grid(const std::string& yaml_text, const std::string& image_bytes,
                                    const std::string& yaml_origin, const std::string& image_origin) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    fail(yaml_origin, std::string("not a readable YAML map: ") + e.what());
-  }
+  const YAML::Node root = load_map_yaml(yaml_text, yaml_origin);
   const MapYaml map = read_map_yaml(root, yaml_origin);
   std::istringstream in(image_bytes, std::ios::in | std::ios::binary);
   return read_pgm(in, map, image_origin);

@@ -1,10 +1,15 @@
 #include "beaconloc/dds/participant.hpp"
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <set>
+#include <sstream>
 #include <string_view>
 #include <thread>
+
+#include "qos_profile_names.hpp"
 
 namespace beaconloc::embedded {
 extern const std::string_view kLoopbackProfilesXml;
@@ -19,11 +24,14 @@ using namespace eprosima::fastdds::dds;
 void load_qos_profiles(const std::vector<std::string>& extra_files) {
   static std::mutex mutex;
   static bool embedded_loaded = false;
+  static QosProfileNames names;               // every profile loaded so far
+  static std::set<std::string> files_loaded;  // each file once per process (one per participant asks)
   std::lock_guard<std::mutex> lock(mutex);
   auto* factory = DomainParticipantFactory::get_instance();
   if (!embedded_loaded) {
     for (std::string_view xml :
          {embedded::kLoopbackProfilesXml, embedded::kTopicProfilesXml, embedded::kRos2TopicProfilesXml}) {
+      names.add(std::string(xml), "the built-in QoS profiles");
       if (factory->load_XML_profiles_string(xml.data(), xml.size()) != ReturnCode_t::RETCODE_OK) {
         throw DdsError("the embedded QoS profiles failed to load");
       }
@@ -31,10 +39,18 @@ void load_qos_profiles(const std::vector<std::string>& extra_files) {
     embedded_loaded = true;
   }
   for (const auto& file : extra_files) {
-    if (!std::ifstream(file).good()) throw DdsError("QoS file '" + file + "' cannot be read");
+    std::ifstream in(file);
+    if (!in.good()) throw DdsError("QoS file '" + file + "' cannot be read");
+    std::error_code ignored;
+    const std::string canonical = std::filesystem::weakly_canonical(file, ignored).string();
+    if (files_loaded.count(canonical)) continue;
+    std::stringstream text;
+    text << in.rdbuf();
+    names.add(text.str(), "QoS file '" + file + "'");
     if (factory->load_XML_profiles_file(file) != ReturnCode_t::RETCODE_OK) {
       throw DdsError("QoS file '" + file + "' is not a valid Fast DDS profiles file");
     }
+    files_loaded.insert(canonical);
   }
 }
 

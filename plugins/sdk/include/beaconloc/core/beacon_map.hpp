@@ -2,7 +2,7 @@
 // The site's ceiling beacons at known positions in the map frame, and the checks a list of
 // beacons must pass to become one: whatever its source (a scenario, a recording's beacons.csv,
 // a BeaconMap sample from the bus), a map with a repeated id, the reserved id or a position that
-// is not a finite number within kMaxBeaconCoordinateM of the origin is refused whole, with the
+// is not a finite number within kMaxMapCoordinateM (core/limits.hpp) is refused whole, with the
 // reason and the beacon that caused it; nothing is "repaired" (the first of two ids kept, a NaN
 // used).
 #include <Eigen/Core>
@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/measurements.hpp"
 
 namespace beaconloc {
@@ -23,9 +24,6 @@ struct Beacon {
   std::uint32_t group = 0;
 };
 
-// A beacon 10 km from the map origin is no indoor ceiling: the bound only catches absurd
-// numbers (1e300, a unit mix-up of 1000x), whose squares would overflow the range model.
-inline constexpr double kMaxBeaconCoordinateM = 1.0e4;
 // More beacons than any site has (a slot every 200 ms would take 13 min to fire them all): a
 // bound on what one sample may make the localizer and decoder hold.
 inline constexpr std::size_t kMaxBeacons = 4096;
@@ -37,7 +35,7 @@ enum class BeaconMapProblem {
   kReservedId,          // kBeaconUnidentified is the id of an anonymous range
   kDuplicateId,         // two beacons with one id
   kNonFinitePosition,   // NaN or infinity in a coordinate
-  kPositionOutOfRange,  // a coordinate beyond kMaxBeaconCoordinateM
+  kPositionOutOfRange,  // a coordinate beyond kMaxMapCoordinateM
 };
 // Stable snake_case names (Diagnostics reasons: beacon_map.<name>).
 const char* to_string(BeaconMapProblem problem);

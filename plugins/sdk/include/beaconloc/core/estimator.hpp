@@ -50,9 +50,10 @@ struct EstimatorConfig {
 };
 
 // NAME=VALUE items (the --param options) as estimator parameters. Throws std::invalid_argument
-// naming the option and the item that is not NAME=VALUE, whose value is not a finite number, or
-// whose name an earlier item gave already. Whether the estimator knows the name and the value is
-// in its range is the estimator's check (core/estimator_parameters.hpp).
+// naming the option and the item that is not NAME=VALUE, whose value is not a decimal number
+// (core/decimal.hpp: "0x1p1", "inf", "1e400" are refused), or whose name an earlier item gave
+// already. Whether the estimator knows the name and the value is in its range is the
+// estimator's check (core/estimator_parameters.hpp).
 std::map<std::string, double> parse_estimator_parameters(const std::vector<std::string>& items,
                                                          const std::string& option_name);
 

@@ -1,15 +1,28 @@
 #pragma once
-// Physical bounds on what the sensors can report, defined once: a number beyond them is no
-// measurement (a corrupted file, a unit mix-up, a hostile sample) and is refused with a reason
-// by whoever reads it first (the replay reader, the estimators, the bridge). They are far beyond
-// any robot this serves, so no real measurement comes near them.
+// Physical limits of the robots and sites beaconloc serves, defined once: every number read from
+// a file, an option or the bus that stands for one of these quantities is refused beyond them
+// (with a reason naming the field), so that no absurd value reaches an estimator.
+
 namespace beaconloc {
 
-// A wheel's ground speed: indoor robots drive at up to 2-3 m/s; 10 m/s is 36 km/h.
+// A wheel's speed over the floor, either way (m/s): odometry rows, simulated trajectories.
 inline constexpr double kMaxWheelSpeedMps = 10.0;
-// The distance between the two drive wheels: large AGVs have 2 m.
+// The distance between a robot's wheels (m).
 inline constexpr double kMaxWheelBaseM = 10.0;
-// A beacon range: ultrasonic beacons reach 15 m, the radio beacons of the CMU recordings 150 m.
-inline constexpr double kMaxRangeM = 1000.0;
+// How far a receiver sits from the robot's centre, along each axis and in height (m).
+inline constexpr double kMaxReceiverOffsetM = 10.0;
+// A map-frame coordinate (m): beacon positions, truth and estimated positions, map origins,
+// initial poses. 1000 km: any site, far from where a double loses centimetres.
+inline constexpr double kMaxMapCoordinateM = 1e6;
+// An angle read from a file (rad): headings may be unwrapped, but not beyond this.
+inline constexpr double kMaxAngleRad = 1e6;
+// The longest range a beacon system measures (m): ultrasonic beacons reach 15 m, the radio
+// beacons of the CMU recordings 150 m.
+inline constexpr double kMaxRangeM = 1e4;
+// The longest run, simulated or replayed (s): 11.6 days, far within the int64 ns clock.
+inline constexpr double kMaxDurationS = 1e6;
+// A time stamp read from a file, in seconds of the recording's clock: within [0, 4.6e9] (146
+// years), so that a stamp, and a stamp minus a time of flight as long, are int64 nanoseconds.
+inline constexpr double kMaxFileStampS = 4.6e9;
 
 }  // namespace beaconloc

@@ -40,7 +40,9 @@ class DdsError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Loads the embedded profiles, then each extra file. Throws DdsError naming a file that fails.
+// Loads the embedded profiles, then each extra file (each once per process). Throws DdsError
+// naming a file that fails, or that defines a profile name already defined (built in, or by an
+// earlier file), or one twice: Fast DDS would only log it and keep the first definition.
 void load_qos_profiles(const std::vector<std::string>& extra_files);
 
 // What a reader tells its participant besides samples (each member optional):

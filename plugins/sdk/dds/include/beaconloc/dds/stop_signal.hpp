@@ -1,5 +1,7 @@
 #pragma once
 // Clean stop on SIGINT, SIGTERM, SIGHUP and SIGPIPE: the handler only sets a flag; loops poll it.
+// The same SIGINT or SIGTERM a second time, while the clean stop is under way (or stuck), ends
+// the process at once with status 128 + the signal's number, saying so on stderr.
 #include <chrono>
 
 namespace beaconloc::dds {

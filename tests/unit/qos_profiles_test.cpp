@@ -1,0 +1,64 @@
+// QoS files (--qos, dds::load_qos_profiles): a file that redefines a built-in profile, or defines
+// one twice, is refused naming the profile (Fast DDS 2.9 only logs it, returns RETCODE_OK and
+// keeps the first definition). Nothing here creates a participant.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "beaconloc/dds/participant.hpp"
+
+namespace beaconloc {
+namespace {
+
+std::string write_qos(const std::string& name, const std::string& profiles) {
+  const auto dir = std::filesystem::temp_directory_path() / ("beaconloc_qos_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << "<?xml version=\"1.0\"?>\n"
+                         "<profiles xmlns=\"http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles\">\n"
+                      << profiles << "</profiles>\n";
+  return path;
+}
+
+std::string error_of(const std::string& file) {
+  try {
+    dds::load_qos_profiles({file});
+  } catch (const dds::DdsError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(QosProfiles, AFileThatRedefinesAProfileIsRefusedNamingIt) {
+  const std::string loopback =
+      write_qos("loopback.xml", "  <participant profile_name=\"beaconloc.loopback\"><rtps/></participant>\n");
+  EXPECT_EQ(error_of(loopback),
+            "QoS file '" + loopback +
+                "':3: participant 'beaconloc.loopback' is already defined (built in, or by an "
+                "earlier file): Fast DDS would keep the first definition; give the profile a "
+                "name of its own");
+  const std::string writer =
+      write_qos("writer.xml", "  <data_writer profile_name=\"raw_tof.writer\"><qos/></data_writer>\n");
+  EXPECT_NE(error_of(writer).find("':3: data_writer 'raw_tof.writer' is already defined"), std::string::npos);
+  const std::string twice = write_qos("twice.xml",
+                                      "  <data_reader profile_name=\"mine.reader\"><qos/></data_reader>\n"
+                                      "  <subscriber profile_name=\"mine.reader\"><qos/></subscriber>\n");
+  EXPECT_NE(error_of(twice).find("':4: subscriber 'mine.reader' is defined twice in this file"),
+            std::string::npos)
+      << error_of(twice);
+  // A file of new names loads, once per process however many participants ask for it; another
+  // file may not take its names.
+  const std::string mine =
+      write_qos("mine.xml", "  <participant profile_name=\"test.mine\"><rtps/></participant>\n");
+  EXPECT_EQ(error_of(mine), "");
+  EXPECT_EQ(error_of(mine), "");
+  const std::string copy =
+      write_qos("copy.xml", "  <participant profile_name=\"test.mine\"><rtps/></participant>\n");
+  EXPECT_NE(error_of(copy).find("participant 'test.mine' is already defined"), std::string::npos);
+  std::filesystem::remove_all(std::filesystem::path(mine).parent_path());
+}
+
+}  // namespace
+}  // namespace beaconloc
