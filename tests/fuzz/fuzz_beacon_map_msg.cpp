@@ -2,16 +2,20 @@
 // from a gateway or anything on the domain): bytes deserialized as a CDR
 // beaconloc::msg::BeaconMap by the type support the participants register
 // (dds::CheckedType<BeaconMapPubSubType>, as Fast DDS calls it), then converted into the core's
-// BeaconMap as the decoder and the localizer convert it (dds::from_msg). No DDS participant.
-// Beyond "no crash, no undefined behaviour, no allocation out of proportion to the input":
-// every beacon of the message is in the map under its id, the map has no more beacons than the
-// message, and the map survives the way back to the wire (to_msg) and again from it unchanged.
+// beacons (dds::from_msg) and checked whole as the decoder, the localizer and the bridge check
+// them (BeaconMap::from, check_beacons). No DDS participant. Beyond "no crash, no undefined
+// behaviour, no allocation out of proportion to the input": a refused map names its problem; a
+// taken one has every beacon of the message under its id, finite and within bounds, and
+// survives the way back to the wire (to_msg) and again from it unchanged.
 #include <beaconlocPubSubTypes.h>
 #include <fastdds/rtps/common/SerializedPayload.h>
 
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "beaconloc/dds/checked_type.hpp"
 #include "beaconloc/dds/convert.hpp"
@@ -37,13 +41,32 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   dds::CheckedType<msg::BeaconMapPubSubType> type;  // what the readers deserialize with
   msg::BeaconMap m;
   if (!type.deserialize(&payload, &m)) return 0;  // Fast DDS drops a sample it cannot read
-  const BeaconMap map = dds::from_msg(m);
-  check(map.size() <= m.beacons().size());
-  for (const auto& b : m.beacons()) check(map.find(b.id()) != nullptr);
-  const BeaconMap back = dds::from_msg(dds::to_msg(map, m.frame_id()));
-  check(back.size() == map.size());
-  for (const auto& b : map.beacons()) {
-    const Beacon* again = back.find(b.id);
+  // What the localizer, decoder and bridge do with it: check it whole (check_beacons), then take
+  // it or refuse it with a reason. A refused map names a problem that is there; a taken one
+  // holds every beacon sent, each finite and in bounds, and survives the wire unchanged.
+  const std::vector<Beacon> sent = dds::from_msg(m);
+  check(sent.size() == m.beacons().size());
+  BeaconMapCheck verdict;
+  const std::optional<BeaconMap> map = BeaconMap::from(sent, &verdict);
+  check(map.has_value() == verdict.ok());
+  if (!map) {
+    check(verdict.problem != BeaconMapProblem::kNone);
+    const std::string reason = to_string(verdict.problem);
+    check(!reason.empty() && reason != "unknown");
+    return 0;
+  }
+  check(map->size() == sent.size());  // no id repeated: nothing overwritten
+  for (const auto& b : sent) {
+    const Beacon* found = map->find(b.id);
+    check(found != nullptr && found->position_map_m.allFinite() &&
+          found->position_map_m.cwiseAbs().maxCoeff() <= kMaxMapCoordinateM);
+  }
+  BeaconMapCheck again_verdict;
+  const std::optional<BeaconMap> back =
+      BeaconMap::from(dds::from_msg(dds::to_msg(*map, m.frame_id())), &again_verdict);
+  check(back.has_value() && back->size() == map->size());
+  for (const auto& b : map->beacons()) {
+    const Beacon* again = back->find(b.id);
     check(again && again->group == b.group);
     for (int i = 0; i < 3; ++i) check(same(again->position_map_m[i], b.position_map_m[i]));
   }

@@ -25,11 +25,11 @@ TEST_F(GatewayStop, ASlowGatewayStopsAtOnceOnASignal) {
                            path(std::string("gateway") + speed + ".log"));
       // Started: its Diagnostics are on the bus (it then sleeps 5-10 s per 10 ms step).
       const auto end = std::chrono::steady_clock::now() + scaled(15s);
-      while (!diagnostics.latest().count("beaconloc.gateway.robot1") &&
+      while (!diagnostics.latest().count("beaconloc.gateway." + robot) &&
              std::chrono::steady_clock::now() < end) {
         std::this_thread::sleep_for(50ms);
       }
-      ASSERT_TRUE(diagnostics.latest().count("beaconloc.gateway.robot1")) << gateway.log();
+      ASSERT_TRUE(diagnostics.latest().count("beaconloc.gateway." + robot)) << gateway.log();
       std::this_thread::sleep_for(200ms);  // into its first long wait
       const auto sent = std::chrono::steady_clock::now();
       gateway.signal(sig);
