@@ -9,7 +9,7 @@ DiagnosticsPublisher::DiagnosticsPublisher(Participant& participant,
     : participant_(participant),
       snapshot_(std::move(snapshot)),
       writer_(participant.writer<msg::DiagnosticsPubSubType>(kDiagnosticsTopic)),
-      task_(std::make_unique<PeriodicTask>(std::chrono::seconds(1), [this] { publish_now(); })) {}
+      task_(std::make_unique<PeriodicTask>(kDiagnosticsPeriod, [this] { publish_now(); })) {}
 
 void DiagnosticsPublisher::publish_now() {
   msg::Diagnostics d = snapshot_();

@@ -4,6 +4,7 @@
 // participant could not deserialize are added as rejections "undecodable_sample".
 #include <beaconloc.h>
 
+#include <chrono>
 #include <functional>
 #include <memory>
 
@@ -11,6 +12,8 @@
 #include "beaconloc/dds/periodic_task.hpp"
 
 namespace beaconloc::dds {
+
+inline constexpr std::chrono::milliseconds kDiagnosticsPeriod{1000};
 
 class DiagnosticsPublisher {
  public:
