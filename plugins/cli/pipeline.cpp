@@ -104,6 +104,48 @@ class ChildProcess {
   std::string log_;
 };
 
+// Waits until each participant (its report name, its process) has reported once: it runs and
+// its readers exist, so that the gateway started next loses none of its first samples, however
+// slowly they started. Throws if one exits first, or does not report within kStartTimeout.
+void wait_until_reporting(const DiagnosticsRecorder& diagnostics,
+                          const std::vector<std::pair<std::string, ChildProcess*>>& participants) {
+  constexpr auto kStartTimeout = 60s;
+  const auto give_up = std::chrono::steady_clock::now() + kStartTimeout;
+  for (const auto& [name, process] : participants) {
+    while (!diagnostics.latest().count(name)) {
+      if (process->done()) {
+        throw std::runtime_error(name + " exited at its start (code " + std::to_string(process->wait(0ms)) +
+                                 "); see " + process->log());
+      }
+      if (dds::wait_for_stop(20ms)) throw std::runtime_error("stopped before " + name + " started");
+      if (std::chrono::steady_clock::now() > give_up) {
+        throw std::runtime_error(name + " did not report within " + std::to_string(kStartTimeout.count()) +
+                                 " s of its start; see " + process->log());
+      }
+    }
+  }
+}
+
+// Waits until the pipeline has drained after the gateway ended: no new pose for kQuiet (a
+// localizer still working through what it holds publishes at the odometry rate), at most
+// kMaxDrain.
+void wait_until_drained(const PoseRecorder& recorder) {
+  constexpr auto kQuiet = 1s;
+  constexpr auto kMaxDrain = 15s;
+  const auto give_up = std::chrono::steady_clock::now() + kMaxDrain;
+  std::size_t seen = recorder.count();
+  auto quiet_since = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() < give_up && !dds::wait_for_stop(20ms)) {
+    const std::size_t now_seen = recorder.count();
+    if (now_seen != seen) {
+      seen = now_seen;
+      quiet_since = std::chrono::steady_clock::now();
+    } else if (std::chrono::steady_clock::now() - quiet_since >= kQuiet) {
+      return;
+    }
+  }
+}
+
 std::string join_receivers(const ReceiverArray& receivers) {
   std::ostringstream s;
   s << std::setprecision(10);
@@ -309,7 +351,8 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
 
   ChildProcess localizer(exe, localizer_args, o.out_dir + "/localizer.log");
   ChildProcess decoder(exe, decoder_args, o.out_dir + "/decoder.log");
-  std::this_thread::sleep_for(1s);  // their readers exist before the gateway writes
+  wait_until_reporting(diagnostics, {{"beaconloc.decoder", &decoder},
+                                     {"beaconloc.localizer." + o.localizer.estimator, &localizer}});
   ChildProcess gateway(exe, gateway_args, o.out_dir + "/gateway.log");
   const auto start = std::chrono::steady_clock::now();
   const double total_s = o.gateway.duration_s > 0.0
@@ -326,7 +369,7 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
     }
   }
   const int gateway_code = gateway.wait(dds::stop_requested() ? 0ms : 10s);
-  std::this_thread::sleep_for(500ms);
+  if (!dds::stop_requested()) wait_until_drained(recorder);
   decoder.terminate();
   localizer.terminate();
   const int decoder_code = decoder.wait(15s), localizer_code = localizer.wait(15s);

@@ -9,7 +9,6 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
-#include <thread>
 
 #include "beaconloc/dds/convert.hpp"
 #include "diagnostics_recorder.hpp"
@@ -25,20 +24,16 @@ using namespace std::chrono_literals;
 
 class BadInput : public ParticipantsTest {
  protected:
-  // The participant's diagnostics once they show `accepted` samples accepted (or a timeout).
-  static msg::Diagnostics diagnostics_of(const DiagnosticsRecorder& recorder, const std::string& name,
-                                         std::uint64_t accepted) {
-    const auto end = std::chrono::steady_clock::now() + scaled(10s);
-    msg::Diagnostics d;
-    while (std::chrono::steady_clock::now() < end) {
-      const auto latest = recorder.latest();
-      if (latest.count(name)) {
-        d = latest.at(name);
-        if (d.accepted() >= accepted) break;
-      }
-      std::this_thread::sleep_for(100ms);
-    }
-    return d;
+  // Writes the beacon map and waits until the participant has taken it: its status turns ok
+  // (before it, degraded: waiting for the beacon map). What comes next on the other topics is
+  // then judged against the map, whatever order the topics would have delivered them in.
+  static void send_map(const DiagnosticsRecorder& recorder, const std::string& name,
+                       eprosima::fastdds::dds::DataWriter* map_writer) {
+    auto map = dds::to_msg(BeaconMap(sim::default_scenario().beacons), "map");
+    ASSERT_TRUE(map_writer->write(&map));
+    const auto d = wait_for_diagnostics(
+        recorder, name, [](const msg::Diagnostics& r) { return r.status() == msg::PARTICIPANT_STATUS_OK; });
+    ASSERT_EQ(d.status(), msg::PARTICIPANT_STATUS_OK) << name << ": " << d.message();
   }
 };
 
@@ -49,9 +44,7 @@ TEST_F(BadInput, DecoderRefusesEveryBadTofByReason) {
   auto* map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
   auto* tof_writer = bus.writer<msg::RawTofPubSubType>(dds::kRawTofTopic);
   ASSERT_TRUE(dds::wait_for_matched_readers({map_writer, tof_writer}, scaled(10s))) << decoder.log();
-  auto map = dds::to_msg(BeaconMap(sim::default_scenario().beacons), "map");
-  map_writer->write(&map);
-  std::this_thread::sleep_for(300ms);
+  ASSERT_NO_FATAL_FAILURE(send_map(diagnostics, kDecoder, map_writer));
 
   std::uint64_t sequence = 0;
   auto tof = [&](StampNs fire_ns, double tof_s) {
@@ -85,8 +78,10 @@ TEST_F(BadInput, DecoderRefusesEveryBadTofByReason) {
     auto m = dds::to_msg("robot1", s);
     ASSERT_EQ(tof_writer->write(&m), true);
   }
-  const auto d = diagnostics_of(diagnostics, "beaconloc.decoder", 4);
-  print_report("beaconloc.decoder", ParticipantReport{d}, std::cout);
+  // One reader takes them in order: the last one, good, is the 4th accepted.
+  const auto d = wait_for_diagnostics(diagnostics, kDecoder,
+                                      [](const msg::Diagnostics& r) { return r.accepted() >= 4; });
+  print_report(kDecoder, ParticipantReport{d}, std::cout);
   EXPECT_EQ(d.accepted(), 4u);
   EXPECT_EQ(rejected_count(d, "non_finite_tof"), 2u);
   EXPECT_EQ(rejected_count(d, "negative_tof"), 1u);
@@ -111,10 +106,8 @@ TEST_F(BadInput, LocalizerRefusesEveryBadSampleByReason) {
   auto* range_writer = bus.writer<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic);
   ASSERT_TRUE(dds::wait_for_matched_readers({map_writer, odometry_writer, range_writer}, scaled(10s)))
       << localizer.log();
+  ASSERT_NO_FATAL_FAILURE(send_map(diagnostics, kRangeEkfLocalizer, map_writer));
   const auto beacons = sim::default_scenario().beacons;
-  auto map = dds::to_msg(BeaconMap(beacons), "map");
-  map_writer->write(&map);
-  std::this_thread::sleep_for(300ms);
 
   std::uint64_t sequence = 0;
   auto odometry = [&](const std::string& robot, StampNs stamp_ns, std::uint64_t skip = 0) {
@@ -150,6 +143,12 @@ TEST_F(BadInput, LocalizerRefusesEveryBadSampleByReason) {
   auto after_gap = odometry("robot1", t, 3);  // three sequence numbers never sent
   odometry_writer->write(&after_gap);
   ++good_odometry;
+  // The ranges are judged against the odometry: it is all taken first (one reader, in order: the
+  // last sample, good, makes the count).
+  const auto odometry_taken =
+      wait_for_diagnostics(diagnostics, kRangeEkfLocalizer,
+                           [&](const msg::Diagnostics& d) { return d.accepted() >= good_odometry; });
+  ASSERT_EQ(odometry_taken.accepted(), good_odometry) << localizer.log();
 
   auto range = [&](StampNs stamp_ns, std::uint32_t beacon, std::uint32_t receiver, double range_m) {
     msg::BeaconRange m;
@@ -176,7 +175,10 @@ TEST_F(BadInput, LocalizerRefusesEveryBadSampleByReason) {
   };
   for (auto& m : ranges) range_writer->write(&m);
 
-  const auto d = diagnostics_of(diagnostics, "beaconloc.localizer.range_ekf", good_odometry + 1);
+  // One reader takes the ranges in order: the last one counts as ahead_of_odometry.
+  const auto d = wait_for_diagnostics(diagnostics, kRangeEkfLocalizer, [](const msg::Diagnostics& r) {
+    return rejected_count(r, "range.ahead_of_odometry") >= 1;
+  });
   print_report("localizer", ParticipantReport{d}, std::cout);
   EXPECT_EQ(d.accepted(), good_odometry + 1);
   EXPECT_EQ(rejected_count(d, "odometry.duplicate_odometry"), 1u);

@@ -17,7 +17,6 @@
 #include "pose_recorder.hpp"
 #include "process.hpp"
 #include "sim/scenario.hpp"
-#include "waits.hpp"
 
 namespace beaconloc::testing {
 namespace {

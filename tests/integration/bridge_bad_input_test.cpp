@@ -16,7 +16,6 @@
 #include "process.hpp"
 #include "ros2_types.hpp"
 #include "sim/scenario.hpp"
-#include "waits.hpp"
 
 namespace beaconloc::testing {
 namespace {
@@ -91,9 +90,9 @@ TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
   bad_map.beacons()[0].x_m(nan);
   map_writer->write(&bad_map);
   // The topic keeps only the newest map: the good one goes once the bad one was refused.
-  const auto refused = wait_for_diagnostics(diagnostics, "beaconloc.bridge", [](const msg::Diagnostics& d) {
-    return rejected_count(d, "beacon_map.non_finite_position") > 0;
-  });
+  const auto refused = wait_for_diagnostics(
+      diagnostics, "beaconloc.bridge.robot1",
+      [](const msg::Diagnostics& d) { return rejected_count(d, "beacon_map.non_finite_position") > 0; });
   EXPECT_EQ(rejected_count(refused, "beacon_map.non_finite_position"), 1u) << refused.message();
   map_writer->write(&map);
 
@@ -116,9 +115,9 @@ TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
     for (const auto& r : ranges) EXPECT_TRUE(std::isfinite(r.range()));
     EXPECT_EQ(marker_arrays, 1u);
   }
-  const auto latest = wait_for_diagnostics(diagnostics, "beaconloc.bridge", [](const msg::Diagnostics& d) {
-    return rejected_count(d, "beacon_map.non_finite_position") > 0;
-  });
+  const auto latest = wait_for_diagnostics(
+      diagnostics, "beaconloc.bridge.robot1",
+      [](const msg::Diagnostics& d) { return rejected_count(d, "beacon_map.non_finite_position") > 0; });
   EXPECT_EQ(rejected_count(latest, "pose.unusable"), 2u);
   EXPECT_EQ(rejected_count(latest, "range.unusable"), 1u);
   EXPECT_EQ(rejected_count(latest, "beacon_map.non_finite_position"), 1u);

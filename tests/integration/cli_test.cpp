@@ -6,9 +6,11 @@
 
 #include <filesystem>
 #include <fstream>
-#include <thread>
 
+#include "beaconloc/dds/wall_clock.hpp"
+#include "diagnostics_recorder.hpp"
 #include "domain_id.hpp"
+#include "participants_test.hpp"
 #include "process.hpp"
 
 namespace beaconloc::testing {
@@ -166,11 +168,19 @@ TEST(Cli, NumbersOfOptionsAndFilesAreRangeCheckedNamingTheCulprit) {
 
 TEST(Cli, ParticipantsStopCleanlyOnSigintAndSigterm) {
   DomainLease domain;
+  dds::DdsOptions dds;
+  dds.domain_id = domain.id();
+  DiagnosticsRecorder diagnostics(dds);
   for (int sig : {SIGINT, SIGTERM}) {
     for (const char* sub : {"decoder", "localizer"}) {
+      const StampNs started_ns = dds::wall_clock_ns();
       ChildProcess p({BEACONLOC_EXECUTABLE, sub, "--domain", std::to_string(domain.id())},
                      "/tmp/beaconloc-cli-signal.log");
-      std::this_thread::sleep_for(scaled(500ms));  // past its start-up (slower under the sanitizers)
+      // Signalled once it runs (its first report), however long its start-up took.
+      const std::string name = std::string(sub) == "decoder" ? kDecoder : kRangeEkfLocalizer;
+      const auto report = wait_for_diagnostics(
+          diagnostics, name, [&](const msg::Diagnostics& d) { return d.stamp_ns() >= started_ns; });
+      ASSERT_GE(report.stamp_ns(), started_ns) << sub << " never reported\n" << p.log();
       p.signal(sig);
       const auto code = p.wait(10s);
       ASSERT_TRUE(code) << sub << " ignored signal " << sig;

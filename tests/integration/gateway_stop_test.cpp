@@ -19,10 +19,12 @@ class GatewayStop : public ParticipantsTest {};
 
 TEST_F(GatewayStop, ASlowGatewayStopsAtOnceOnASignal) {
   DiagnosticsRecorder diagnostics(dds_);
+  int run = 0;
   for (const char* speed : {"0.002", "0.001"}) {
     for (int sig : {SIGTERM, SIGINT}) {
-      ChildProcess gateway(command("gateway", {"--speed", speed}),
-                           path(std::string("gateway") + speed + ".log"));
+      // A robot id of its own per run: the Diagnostics seen are this process's, not the last one's.
+      const std::string robot = "slow" + std::to_string(++run);
+      ChildProcess gateway(command("gateway", {"--speed", speed, "--robot", robot}), path(robot + ".log"));
       // Started: its Diagnostics are on the bus (it then sleeps 5-10 s per 10 ms step).
       const auto end = std::chrono::steady_clock::now() + scaled(15s);
       while (!diagnostics.latest().count("beaconloc.gateway." + robot) &&

@@ -8,7 +8,6 @@
 #include "diagnostics_recorder.hpp"
 #include "participants_test.hpp"
 #include "process.hpp"
-#include "waits.hpp"
 
 namespace beaconloc::testing {
 namespace {
@@ -28,9 +27,9 @@ TEST_F(PeerLoss, TheLocalizerSaysItsDecoderDiedAndTheBridgeItsLocalizer) {
   auto decoder = std::make_unique<ChildProcess>(command("decoder"), path("decoder.log"));
   auto localizer = std::make_unique<ChildProcess>(command("localizer"), path("localizer.log"));
   ChildProcess bridge(command("bridge"), path("bridge.log"));
-  const auto live = wait_for_diagnostics(diagnostics, "beaconloc.bridge", [](const msg::Diagnostics& d) {
-    return d.status() == msg::PARTICIPANT_STATUS_OK;
-  });
+  const auto live = wait_for_diagnostics(
+      diagnostics, "beaconloc.bridge.robot1",
+      [](const msg::Diagnostics& d) { return d.status() == msg::PARTICIPANT_STATUS_OK; });
   ASSERT_EQ(live.status(), msg::PARTICIPANT_STATUS_OK) << live.message() << "\n" << localizer->log();
 
   decoder->signal(SIGKILL);  // dies without leaving: only its lapsed liveliness tells
@@ -42,9 +41,9 @@ TEST_F(PeerLoss, TheLocalizerSaysItsDecoderDiedAndTheBridgeItsLocalizer) {
   EXPECT_EQ(orphaned.status(), msg::PARTICIPANT_STATUS_DEGRADED);
 
   stop_cleanly(*localizer, "localizer");
-  const auto silent = wait_for_diagnostics(diagnostics, "beaconloc.bridge", [](const msg::Diagnostics& d) {
-    return says(d, "the localizer is gone or silent");
-  });
+  const auto silent = wait_for_diagnostics(
+      diagnostics, "beaconloc.bridge.robot1",
+      [](const msg::Diagnostics& d) { return says(d, "the localizer is gone or silent"); });
   EXPECT_TRUE(says(silent, "the localizer is gone or silent")) << silent.message();
   EXPECT_EQ(silent.status(), msg::PARTICIPANT_STATUS_DEGRADED);
   stop_cleanly(bridge, "bridge");

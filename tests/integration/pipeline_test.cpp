@@ -20,29 +20,22 @@ namespace {
 
 using namespace std::chrono_literals;
 
-class Pipeline : public ParticipantsTest {
- protected:
-  // Waits for the gateway to finish its run, lets the last samples through, stops the others.
-  static void finish_run(ChildProcess& gateway, ChildProcess& decoder, ChildProcess& localizer) {
-    const auto gateway_code = gateway.wait(90s);
-    ASSERT_TRUE(gateway_code) << "gateway did not finish";
-    EXPECT_EQ(*gateway_code, 0) << gateway.log();
-    std::this_thread::sleep_for(500ms);
-    stop_cleanly(decoder, "decoder");
-    stop_cleanly(localizer, "localizer");
-  }
-};
+class Pipeline : public ParticipantsTest {};
 
 TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   PoseRecorder recorder(dds_);
   DiagnosticsRecorder diagnostics(dds_);
   ChildProcess localizer(command("localizer"), path("localizer.log"));
   ChildProcess decoder(command("decoder"), path("decoder.log"));
-  std::this_thread::sleep_for(1s);  // let the late processes' readers appear first
+  // Their readers exist before the gateway writes, however slowly they started.
+  ASSERT_TRUE(wait_until_reporting(diagnostics, {kDecoder, kRangeEkfLocalizer}))
+      << decoder.log() << localizer.log();
   ChildProcess gateway(command("gateway", {"--robot", "robot7", "--duration-s", "25", "--seed", "5",
                                            "--truth-out", path("truth.csv")}),
                        path("gateway.log"));
-  ASSERT_NO_FATAL_FAILURE(finish_run(gateway, decoder, localizer));
+  ASSERT_NO_FATAL_FAILURE(finish_gateway(gateway, recorder, "robot7", path("truth.csv")));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
 
   const auto poses = recorder.poses();
   ASSERT_GT(poses.size(), 100u) << "localizer log:\n" << localizer.log();
@@ -66,23 +59,31 @@ TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   const auto latest = diagnostics.latest();
   print_diagnostics(diagnostics.reports(), std::cout);
   ASSERT_EQ(latest.count("beaconloc.gateway.robot7"), 1u);
-  ASSERT_EQ(latest.count("beaconloc.decoder"), 1u);
-  ASSERT_EQ(latest.count("beaconloc.localizer.range_ekf"), 1u);
-  const auto& decoder_diag = latest.at("beaconloc.decoder");
+  ASSERT_EQ(latest.count(kDecoder), 1u);
+  ASSERT_EQ(latest.count(kRangeEkfLocalizer), 1u);
+  const auto& decoder_diag = latest.at(kDecoder);
   EXPECT_GT(decoder_diag.accepted(), 250u);      // 15 TOF/s for > 20 s, less the last second
   EXPECT_TRUE(decoder_diag.rejected().empty());  // the simulated source sends no bad TOF
-  EXPECT_GT(latest.at("beaconloc.localizer.range_ekf").accepted(), 1500u);
+  EXPECT_GT(latest.at(kRangeEkfLocalizer).accepted(), 1500u);
 }
 
 TEST_F(Pipeline, LateJoiningLocalizerGetsTheMapAndLocalizes) {
+  DiagnosticsRecorder diagnostics(dds_);
   ChildProcess gateway(command("gateway", {"--robot", "late", "--duration-s", "20", "--seed", "6",
                                            "--truth-out", path("truth.csv")}),
                        path("gateway.log"));
   ChildProcess decoder(command("decoder"), path("decoder.log"));
-  std::this_thread::sleep_for(5s);  // the beacon map was written 5 s ago, once
+  // The localizer joins ~5 s into the run, long after the gateway wrote the beacon map, once:
+  // when the decoder (which needs that map) has decoded 4 s of TOFs (15 a second), counted from
+  // the run's progress, not from when this test started the gateway.
+  const auto decoding = wait_for_diagnostics(diagnostics, kDecoder,
+                                             [](const msg::Diagnostics& d) { return d.accepted() >= 60; });
+  ASSERT_GE(decoding.accepted(), 60u) << decoder.log() << gateway.log();
   PoseRecorder recorder(dds_);
   ChildProcess localizer(command("localizer"), path("localizer.log"));
-  ASSERT_NO_FATAL_FAILURE(finish_run(gateway, decoder, localizer));
+  ASSERT_NO_FATAL_FAILURE(finish_gateway(gateway, recorder, "late", path("truth.csv")));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
 
   const auto poses = recorder.poses();
   ASSERT_GT(poses.size(), 100u) << "localizer log:\n" << localizer.log();
@@ -92,7 +93,7 @@ TEST_F(Pipeline, LateJoiningLocalizerGetsTheMapAndLocalizes) {
       ns_to_s(poses.back().row.estimate.stamp_ns - poses.front().row.estimate.stamp_ns);
   std::printf("late-joining localizer: %zu poses over %.1f s at %.1f Hz; position RMS %.3f m\n", s.poses,
               stamp_span_s, s.pose_rate_hz, s.metrics.position_rms_m);
-  // Started 5 s into a 20 s run: localizing within ~3 s of its start leaves >= 12 s of poses.
+  // Started ~5 s into a 20 s run: localizing within ~3 s of its start leaves >= 12 s of poses.
   EXPECT_GE(stamp_span_s, 12.0);
   EXPECT_EQ(s.metrics.samples_without_truth, 0u);
   EXPECT_GE(s.pose_rate_hz, 90.0);
@@ -101,20 +102,24 @@ TEST_F(Pipeline, LateJoiningLocalizerGetsTheMapAndLocalizes) {
 
 TEST_F(Pipeline, TwoRobotsShareTheTopicsWithoutCrosstalk) {
   PoseRecorder recorder(dds_);
+  DiagnosticsRecorder diagnostics(dds_);
   ChildProcess localizer(command("localizer"), path("localizer.log"));
   ChildProcess decoder(command("decoder"), path("decoder.log"));
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(wait_until_reporting(diagnostics, {kDecoder, kRangeEkfLocalizer}))
+      << decoder.log() << localizer.log();
   ChildProcess second(command("gateway", {"--robot", "beta", "--duration-s", "15", "--seed", "8",
                                           "--truth-out", path("beta.csv")}),
                       path("beta.log"));
-  std::this_thread::sleep_for(3s);  // alpha drives the same loop 3 s (1 m) behind beta
+  // Not a wait for anything: alpha drives the same loop ~3 s (1 m) behind beta, so that poses
+  // mixed up between the robots would show as errors.
+  std::this_thread::sleep_for(3s);
   ChildProcess first(command("gateway", {"--robot", "alpha", "--duration-s", "15", "--seed", "7",
                                          "--truth-out", path("alpha.csv")}),
                      path("alpha.log"));
-  const auto second_code = second.wait(90s);
-  ASSERT_TRUE(second_code);
-  EXPECT_EQ(*second_code, 0) << second.log();
-  ASSERT_NO_FATAL_FAILURE(finish_run(first, decoder, localizer));
+  ASSERT_NO_FATAL_FAILURE(finish_gateway(second, recorder, "beta", path("beta.csv")));
+  ASSERT_NO_FATAL_FAILURE(finish_gateway(first, recorder, "alpha", path("alpha.csv")));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
 
   std::map<std::string, std::vector<RecordedPose>> by_robot;
   for (const auto& p : recorder.poses()) by_robot[p.row.robot_id].push_back(p);

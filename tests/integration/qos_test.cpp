@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "beaconloc/core/pose_error.hpp"
+#include "beaconloc/dds/diagnostics_publisher.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
 #include "diagnostics_recorder.hpp"
 #include "domain_id.hpp"
@@ -80,13 +81,18 @@ TEST_F(Qos, SilentTofsAreNoticedWithinTwoSlotsAndTheLocalizerCoastsThenRecovers)
   DiagnosticsRecorder diagnostics(dds_);
   ChildProcess localizer(command("localizer"), path("localizer.log"));
   ChildProcess decoder(command("decoder"), path("decoder.log"));
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(wait_until_reporting(diagnostics, {kDecoder, kRangeEkfLocalizer}))
+      << decoder.log() << localizer.log();
   ChildProcess gateway(command("gateway", {"--duration-s", "14", "--seed", "4", "--fault", "tof_outage=6:9",
                                            "--truth-out", path("truth.csv")}),
                        path("gateway.log"));
-  ASSERT_TRUE(gateway.wait(60s)) << gateway.log();
-  std::this_thread::sleep_for(1500ms);  // a last diagnostics round
-  const auto latest = diagnostics.latest();
+  ASSERT_NO_FATAL_FAILURE(finish_gateway(gateway, poses, "robot1", path("truth.csv")));
+  // A last diagnostics round, sent after the run ended.
+  const StampNs ended_ns = dds::wall_clock_ns();
+  auto after_end = [&](const msg::Diagnostics& d) { return d.stamp_ns() >= ended_ns; };
+  const std::map<std::string, msg::Diagnostics> latest = {
+      {kDecoder, wait_for_diagnostics(diagnostics, kDecoder, after_end)},
+      {kRangeEkfLocalizer, wait_for_diagnostics(diagnostics, kRangeEkfLocalizer, after_end)}};
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
 
@@ -126,10 +132,8 @@ TEST_F(Qos, SilentTofsAreNoticedWithinTwoSlotsAndTheLocalizerCoastsThenRecovers)
   EXPECT_LE(coasting_max_error_m, 0.10);     // dead reckoning over 3 s
   EXPECT_GT(ok_after, 200u);
   EXPECT_EQ(degraded_after, 0u);
-  ASSERT_EQ(latest.count("beaconloc.decoder"), 1u);
-  ASSERT_EQ(latest.count("beaconloc.localizer.range_ekf"), 1u);
-  EXPECT_GE(latest.at("beaconloc.decoder").deadline_misses(), 1u);
-  EXPECT_GE(latest.at("beaconloc.localizer.range_ekf").deadline_misses(), 1u);
+  EXPECT_GE(latest.at(kDecoder).deadline_misses(), 1u);
+  EXPECT_GE(latest.at(kRangeEkfLocalizer).deadline_misses(), 1u);
 }
 
 // Liveliness (manual by topic, asserted by the gateway every 250 ms, 1 s lease): a gateway killed with
@@ -140,30 +144,24 @@ TEST_F(Qos, DeadGatewayIsNoticedByLivelinessAndARestartedOneIsPickedUp) {
   DiagnosticsRecorder diagnostics(dds_);
   ChildProcess localizer(command("localizer"), path("localizer.log"));
   ChildProcess decoder(command("decoder"), path("decoder.log"));
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(wait_until_reporting(diagnostics, {kDecoder, kRangeEkfLocalizer}))
+      << decoder.log() << localizer.log();
   {
-    ChildProcess first(command("gateway", {"--duration-s", "60", "--seed", "8"}), path("gateway1.log"));
-    std::this_thread::sleep_for(scaled(5s));
+    // Until killed; killed once the localizer has tracked its robot for 3 s: the decoder and the
+    // localizer take its samples, its writers are alive to them.
+    ChildProcess first(command("gateway", {"--duration-s", "0", "--seed", "8"}), path("gateway1.log"));
+    ASSERT_TRUE(wait_for_pose(poses, "robot1", 0, 30s)) << first.log() << localizer.log();
+    ASSERT_TRUE(wait_for_pose(poses, "robot1", poses.poses().front().row.estimate.stamp_ns + s_to_ns(3.0)))
+        << localizer.log();
     first.signal(SIGKILL);
     ASSERT_TRUE(first.wait(5s));
   }
   const auto killed = std::chrono::steady_clock::now();
   // Lease 1 s, then the next diagnostics round (1 Hz).
-  std::map<std::string, msg::Diagnostics> latest;
-  while (std::chrono::steady_clock::now() - killed < scaled(6s)) {
-    latest = diagnostics.latest();
-    if (latest.count("beaconloc.decoder") && latest.at("beaconloc.decoder").writers_lost() > 0 &&
-        latest.count("beaconloc.localizer.range_ekf") &&
-        latest.at("beaconloc.localizer.range_ekf").writers_lost() > 0) {
-      break;
-    }
-    std::this_thread::sleep_for(50ms);
-  }
+  auto lost = [](const msg::Diagnostics& d) { return d.writers_lost() > 0; };
+  const msg::Diagnostics dec = wait_for_diagnostics(diagnostics, kDecoder, lost, 10s);
+  const msg::Diagnostics loc = wait_for_diagnostics(diagnostics, kRangeEkfLocalizer, lost, 10s);
   const double noticed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
-  ASSERT_EQ(latest.count("beaconloc.decoder"), 1u);
-  ASSERT_EQ(latest.count("beaconloc.localizer.range_ekf"), 1u);
-  const auto& dec = latest.at("beaconloc.decoder");
-  const auto& loc = latest.at("beaconloc.localizer.range_ekf");
   std::printf("gateway killed: reported lost by decoder and localizer %.2f s later (%s / %s)\n", noticed_s,
               dec.message().c_str(), loc.message().c_str());
   EXPECT_GE(dec.writers_lost(), 1u);
@@ -176,12 +174,10 @@ TEST_F(Qos, DeadGatewayIsNoticedByLivelinessAndARestartedOneIsPickedUp) {
   ChildProcess second(
       command("gateway", {"--duration-s", "12", "--seed", "9", "--truth-out", path("truth.csv")}),
       path("gateway2.log"));
-  ASSERT_TRUE(second.wait(60s)) << second.log();
-  std::this_thread::sleep_for(1500ms);
+  ASSERT_NO_FATAL_FAILURE(finish_gateway(second, poses, "robot1", path("truth.csv")));
   EXPECT_TRUE(running(decoder) && running(localizer)) << "nobody else was restarted";
-  latest = diagnostics.latest();
-  EXPECT_EQ(latest.at("beaconloc.decoder").status(), msg::PARTICIPANT_STATUS_OK)
-      << latest.at("beaconloc.decoder").message();
+  const msg::Diagnostics decoder_after = diagnostics.latest().at(kDecoder);
+  EXPECT_EQ(decoder_after.status(), msg::PARTICIPANT_STATUS_OK) << decoder_after.message();
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
 
@@ -212,26 +208,35 @@ TEST_F(Qos, DeadGatewayIsNoticedByLivelinessAndARestartedOneIsPickedUp) {
 // bus and are never decoded, so never fused.
 TEST_F(Qos, TofsOlderThanTheirLifespanAreNeverDecoded) {
   RangeRecorder ranges(dds_);
+  DiagnosticsRecorder diagnostics(dds_);
   ChildProcess decoder(command("decoder"), path("decoder.log"));
-  std::this_thread::sleep_for(1s);
-  ChildProcess gateway(command("gateway", {"--duration-s", "10", "--seed", "3"}), path("gateway.log"));
-  std::this_thread::sleep_for(scaled(4s));
+  ASSERT_TRUE(wait_until_reporting(diagnostics, {kDecoder})) << decoder.log();
+  // Until stopped: it runs through the stall and after it, as long as the test needs.
+  ChildProcess gateway(command("gateway", {"--duration-s", "0", "--seed", "3"}), path("gateway.log"));
+  // Stalled once 2 s of ranges (15 a second) came through.
+  ASSERT_TRUE(eventually([&] { return ranges.ranges().size() >= 30; }, 30s))
+      << gateway.log() << decoder.log();
   decoder.signal(SIGSTOP);
-  std::this_thread::sleep_for(1500ms);
+  std::this_thread::sleep_for(1500ms);  // the stall
   const StampNs resumed_wall_ns = dds::wall_clock_ns();
   decoder.signal(SIGCONT);
-  ASSERT_TRUE(gateway.wait(60s)) << gateway.log();
-  std::this_thread::sleep_for(500ms);
+  // The backlog is through once ranges of TOFs fired after the resume come (one writer: in order).
+  ASSERT_TRUE(eventually(
+      [&] {
+        const auto all = ranges.ranges();
+        return std::any_of(all.begin(), all.end(),
+                           [&](const RangeRecorder::Received& r) { return r.stamp_ns > resumed_wall_ns; });
+      },
+      30s))
+      << decoder.log();
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(gateway, "gateway"));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
 
-  // Ranges decoded in the 300 ms after the resume: the stall's backlog.
+  // The stall's backlog: ranges decoded after the resume of TOFs fired before it.
   double oldest_age_s = 0.0;
   std::size_t backlog = 0;
   for (const auto& r : ranges.ranges()) {
-    if (r.received_wall_ns < resumed_wall_ns ||
-        r.received_wall_ns > resumed_wall_ns + s_to_ns(0.3 * kTimeScale)) {
-      continue;
-    }
+    if (r.received_wall_ns < resumed_wall_ns || r.stamp_ns >= resumed_wall_ns) continue;
     ++backlog;
     oldest_age_s = std::max(oldest_age_s, ns_to_s(resumed_wall_ns - r.stamp_ns));
   }
@@ -250,29 +255,39 @@ TEST_F(Qos, OdometryHistoryCoversAStalledLocalizerAndLostIncrementsAreCounted) {
   DiagnosticsRecorder diagnostics(dds_);
   ChildProcess localizer(command("localizer"), path("localizer.log"));
   ChildProcess decoder(command("decoder"), path("decoder.log"));
-  std::this_thread::sleep_for(1s);
-  ChildProcess gateway(command("gateway", {"--duration-s", "14", "--seed", "2"}), path("gateway.log"));
-  std::this_thread::sleep_for(scaled(3s));
+  ASSERT_TRUE(wait_until_reporting(diagnostics, {kDecoder, kRangeEkfLocalizer}))
+      << decoder.log() << localizer.log();
+  // Until stopped: it runs through every stall and after them, as long as the test needs.
+  ChildProcess gateway(command("gateway", {"--duration-s", "0", "--seed", "2"}), path("gateway.log"));
+  // Stalled once it has taken 3 s of odometry (100 Hz).
+  const auto steady = wait_for_diagnostics(diagnostics, kRangeEkfLocalizer,
+                                           [](const msg::Diagnostics& d) { return d.accepted() >= 300; });
+  ASSERT_GE(steady.accepted(), 300u) << gateway.log() << localizer.log();
   for (int i = 0; i < 5; ++i) {
     localizer.signal(SIGSTOP);
     std::this_thread::sleep_for(300ms);
     localizer.signal(SIGCONT);
     std::this_thread::sleep_for(700ms);
   }
-  std::this_thread::sleep_for(1500ms);
-  const auto after_short = diagnostics.latest();
+  // Its report from 1.5 s after the stalls: what they cost is counted.
+  const StampNs short_counted_ns = dds::wall_clock_ns() + s_to_ns(1.5);
+  const auto short_stalls =
+      wait_for_diagnostics(diagnostics, kRangeEkfLocalizer,
+                           [&](const msg::Diagnostics& d) { return d.stamp_ns() >= short_counted_ns; });
   localizer.signal(SIGSTOP);
   std::this_thread::sleep_for(1500ms);
+  const StampNs resumed_ns = dds::wall_clock_ns();
   localizer.signal(SIGCONT);
-  ASSERT_TRUE(gateway.wait(60s)) << gateway.log();
-  std::this_thread::sleep_for(1500ms);
-  const auto after_long = diagnostics.latest();
+  // It caught up: a report after the resume with 3 s more of odometry taken.
+  const auto long_stall =
+      wait_for_diagnostics(diagnostics, kRangeEkfLocalizer, [&](const msg::Diagnostics& d) {
+        return d.stamp_ns() >= resumed_ns && d.accepted() > short_stalls.accepted() + 300u;
+      });
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(gateway, "gateway"));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
 
-  ASSERT_EQ(after_short.count("beaconloc.localizer.range_ekf"), 1u);
-  const auto& short_stalls = after_short.at("beaconloc.localizer.range_ekf");
-  const auto& long_stall = after_long.at("beaconloc.localizer.range_ekf");
+  ASSERT_GE(short_stalls.stamp_ns(), short_counted_ns) << "no report after the short stalls";
   const std::uint64_t lost_short = rejected_count(short_stalls, "odometry.lost_increment");
   const std::uint64_t lost_long = rejected_count(long_stall, "odometry.lost_increment");
   std::printf(
@@ -281,30 +296,47 @@ TEST_F(Qos, OdometryHistoryCoversAStalledLocalizerAndLostIncrementsAreCounted) {
       static_cast<unsigned long long>(lost_long));
   EXPECT_EQ(lost_short, 0u);
   EXPECT_EQ(rejected_count(short_stalls, "odometry.odometry_gap"), 0u);
-  EXPECT_GT(short_stalls.accepted(), 800u);  // > 8 s of 100 Hz odometry
+  EXPECT_GT(short_stalls.accepted(), 800u);  // > 8 s of 100 Hz odometry: 3 s, then 6.5 s of stalls
   // 1.5 s is three times the history: what the bus could not hold is counted, not hidden.
   EXPECT_LE(lost_long, 150u);
   EXPECT_GT(long_stall.accepted(), short_stalls.accepted() + 300u);  // it caught up
 }
 
 // A localizer killed mid-run (SIGKILL) and started again has no prior pose: it finds the robot
-// from the beacons alone (a global fix over its first ranges) within 2 s of its start.
+// from the beacons alone (a global fix over its first ranges) within 2 s of its start. Its start
+// is when its participant and endpoints exist (one Diagnostics period before its first report),
+// not when its process was spawned: loading a process on a busy machine is not what is measured.
 TEST_F(Qos, KilledLocalizerRestartedMidRunReconvergesFromBeaconsAlone) {
   PoseRecorder poses(dds_);
+  DiagnosticsRecorder diagnostics(dds_);
   ChildProcess decoder(command("decoder"), path("decoder.log"));
   std::optional<ChildProcess> localizer;
   localizer.emplace(command("localizer"), path("localizer1.log"));
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(wait_until_reporting(diagnostics, {kDecoder, kRangeEkfLocalizer}))
+      << decoder.log() << localizer->log();
+  // Until stopped: it runs until the restarted localizer has tracked for 9 s.
   ChildProcess gateway(
-      command("gateway", {"--duration-s", "16", "--seed", "6", "--truth-out", path("truth.csv")}),
+      command("gateway", {"--duration-s", "0", "--seed", "6", "--truth-out", path("truth.csv")}),
       path("gateway.log"));
-  std::this_thread::sleep_for(scaled(6s));
+  // Killed mid-run: once it has tracked the robot for 4 s.
+  ASSERT_TRUE(wait_for_pose(poses, "robot1", 0, 30s)) << gateway.log() << localizer->log();
+  ASSERT_TRUE(wait_for_pose(poses, "robot1", poses.poses().front().row.estimate.stamp_ns + s_to_ns(4.0)))
+      << localizer->log();
   localizer->signal(SIGKILL);
   ASSERT_TRUE(localizer->wait(5s));
-  const StampNs restarted_wall_ns = dds::wall_clock_ns();
+  const StampNs spawned_wall_ns = dds::wall_clock_ns();
   localizer.emplace(command("localizer"), path("localizer2.log"));
-  ASSERT_TRUE(gateway.wait(60s)) << gateway.log();
-  std::this_thread::sleep_for(500ms);
+  const auto first_report =
+      wait_for_diagnostics(diagnostics, kRangeEkfLocalizer,
+                           [&](const msg::Diagnostics& d) { return d.stamp_ns() > spawned_wall_ns; });
+  ASSERT_GT(first_report.stamp_ns(), spawned_wall_ns) << "the restarted localizer never reported\n"
+                                                      << localizer->log();
+  const StampNs restarted_wall_ns =
+      first_report.stamp_ns() -
+      std::chrono::duration_cast<std::chrono::nanoseconds>(dds::kDiagnosticsPeriod).count();
+  // 9 s of the run after the restart (the restarted localizer's poses, or none: checked below).
+  wait_for_pose(poses, "robot1", restarted_wall_ns + s_to_ns(9.0), 60s);
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(gateway, "gateway"));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(*localizer, "localizer"));
 
@@ -323,8 +355,10 @@ TEST_F(Qos, KilledLocalizerRestartedMidRunReconvergesFromBeaconsAlone) {
   ASSERT_TRUE(first_pose && converged) << localizer->log();
   const double reconverged_s = ns_to_s(*converged - restarted_wall_ns);
   std::printf(
-      "localizer restarted: first pose %.2f s, within 0.1 m %.2f s after its start; RMS after %.3f m\n",
-      ns_to_s(*first_pose - restarted_wall_ns), reconverged_s, after.position_rms_m());
+      "localizer restarted: started %.2f s after it was spawned; first pose %.2f s, within 0.1 m %.2f s "
+      "after its start; RMS after %.3f m\n",
+      ns_to_s(restarted_wall_ns - spawned_wall_ns), ns_to_s(*first_pose - restarted_wall_ns), reconverged_s,
+      after.position_rms_m());
   EXPECT_LE(reconverged_s, 2.0 * kTimeScale);  // the 2 s, in a Release build
   EXPECT_LE(after.position_rms_m(), 0.05);
 }

@@ -10,12 +10,13 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
-#include <thread>
 
 #include "beaconloc/core/csv_reader.hpp"
 #include "beaconloc/core/occupancy_grid_io.hpp"
 #include "beaconloc/dds/participant.hpp"
+#include "diagnostics_recorder.hpp"
 #include "domain_id.hpp"
+#include "participants_test.hpp"
 #include "process.hpp"
 #include "ros2_convert.hpp"
 
@@ -25,6 +26,8 @@ namespace {
 using namespace std::chrono_literals;
 
 const std::string kSource = BEACONLOC_SOURCE_DIR;
+// What cyclone_ros2_peer prints once its rt/odom and rt/scan writers exist.
+const char* const kPeerWritersUp = "cyclone peer: writers up";
 
 template <class T>
 struct Inbox {
@@ -44,17 +47,6 @@ struct Inbox {
   }
 };
 
-// Waits until pred() holds or the timeout (scaled() under the sanitizers) passes.
-template <class Pred>
-bool eventually(Pred pred, std::chrono::milliseconds timeout) {
-  const auto end = std::chrono::steady_clock::now() + scaled(timeout);
-  while (!pred()) {
-    if (std::chrono::steady_clock::now() > end) return false;
-    std::this_thread::sleep_for(20ms);
-  }
-  return true;
-}
-
 TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) {
   DomainLease domain;
   char dir[] = "/tmp/beaconloc-bridge-XXXXXX";
@@ -62,8 +54,8 @@ TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) 
   // Until stopped (--duration-s 0): the test owns the run's lifetime and ends it when every step
   // below is done; a fixed duration raced them (under load the run ended before the initial
   // pose and the late readers).
-  ChildProcess run({BEACONLOC_EXECUTABLE, "run", "--bridge", "--speed", "1", "--duration-s", "0", "--out", dir,
-                    "--domain", std::to_string(domain.id())},
+  ChildProcess run({BEACONLOC_EXECUTABLE, "run", "--bridge", "--speed", "1", "--duration-s", "0", "--out",
+                    dir, "--domain", std::to_string(domain.id())},
                    std::string(dir) + "/run.log");
 
   dds::DdsOptions options;
@@ -164,7 +156,7 @@ TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) 
     ASSERT_TRUE(dds::wait_for_matched_readers({writer}, scaled(5s)));
     writer->write(&reset);
     EXPECT_TRUE(
-        eventually([&] { return std::abs(poses.last().pose().pose().position().x() - wanted_x) < 0.4; }, 5s))
+        eventually([&] { return std::abs(poses.last().pose().pose().position().x() - wanted_x) < 0.4; }, 10s))
         << "last x " << poses.last().pose().pose().position().x() << ", wanted about " << wanted_x;
     rviz.close();
   }
@@ -180,7 +172,7 @@ TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) 
                                                      [&](const auto& m) { late_static.add(m); });
   late.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>({"rt/beacons", "", "late.reader"},
                                                                  [&](const auto& m) { late_beacons.add(m); });
-  ASSERT_TRUE(eventually([&] { return late_poses.size() && late_static.size() && late_beacons.size(); }, 5s))
+  ASSERT_TRUE(eventually([&] { return late_poses.size() && late_static.size() && late_beacons.size(); }, 10s))
       << late_poses.size() << " " << late_static.size() << " " << late_beacons.size();
   const auto frames = late_static.last();
   ASSERT_EQ(frames.transforms().size(), 3u);  // the three receivers of the built-in robot
@@ -230,16 +222,25 @@ TEST_P(CycloneRobot, FeedsTheBridgeAndReadsItsOutputsBack) {
         d + "/bridge.log"));
     return p;
   };
+  // Who is first is made sure of, not hoped for: the bridge and the localizer report (their
+  // readers exist), or the peer says its writers are up, before the other side starts.
+  dds::DdsOptions dds;
+  dds.domain_id = domain.id();
+  DiagnosticsRecorder diagnostics(dds);
   std::vector<std::unique_ptr<ChildProcess>> pipeline;
   if (bridge_first) {
     pipeline = start_pipeline();
-    std::this_thread::sleep_for(2s);
+    ASSERT_TRUE(wait_until_reporting(diagnostics,
+                                     {"beaconloc.bridge.robot1", "beaconloc.localizer.ukf_lrf_laser_only"}))
+        << pipeline[1]->log() << pipeline[0]->log();
   }
-  ChildProcess peer({CYCLONE_ROS2_PEER, "--domain", domain_id, "--seconds", "40", "--beacons",
-                     "1:0.5:0.5:2.5,2:3.5:2.5:2.5"},
+  // --seconds: how long the peer waits for correct outputs before it fails (a timeout, scaled).
+  ChildProcess peer({CYCLONE_ROS2_PEER, "--domain", domain_id, "--seconds", std::to_string(40 * kTimeScale),
+                     "--beacons", "1:0.5:0.5:2.5,2:3.5:2.5:2.5"},
                     d + "/peer.log");
   if (!bridge_first) {
-    std::this_thread::sleep_for(2s);
+    ASSERT_TRUE(eventually([&] { return peer.log().find(kPeerWritersUp) != std::string::npos; }, 20s))
+        << peer.log();
     pipeline = start_pipeline();
   }
   const auto code = peer.wait(60s);

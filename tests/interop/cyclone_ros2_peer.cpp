@@ -6,8 +6,9 @@
 //   rt/scan  sensor_msgs/LaserScan, best effort (sensor-data QoS), 19 beams, 25 Hz;
 // and reads what rviz2 and tf2 would: rt/beacon_pose, rt/tf, rt/odometry/beacons (reliable,
 // volatile), rt/beacons and rt/tf_static (reliable, transient local), checking every field it can
-// know. Exit 0 once every topic has delivered a correct sample; 1, with the failures on stderr,
-// at the first wrong field or when --seconds run out.
+// know. Prints "cyclone peer: writers up" once its endpoints exist. Exit 0 once every topic has
+// delivered a correct sample; 1, with the failures on stderr, at the first wrong field or when
+// --seconds run out.
 //   cyclone_ros2_peer --domain N --seconds S --beacons ID:X:Y:Z[,ID:X:Y:Z...]
 #include <dds/dds.h>
 
@@ -129,6 +130,9 @@ int main(int argc, char** argv) {
   dds_delete_qos(scan_qos);
   dds_delete_qos(rviz_qos);
   dds_delete_qos(latched_qos);
+  // For a test that starts the bridge only once the robot is there (integration.*RobotFirst).
+  std::printf("cyclone peer: writers up\n");
+  std::fflush(stdout);
 
   // The robot stands at x0 until both its writers have a reader (the bridge), then 3 s more, and
   // drives: either start order finds it where the localizer was told it starts.

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #ifndef BEACONLOC_TEST_TIME_SCALE
@@ -42,5 +43,17 @@ class ChildProcess {
 // Runs to completion and returns (exit code, output); -1 on timeout (scaled() by kTimeScale).
 std::pair<int, std::string> run_command(const std::vector<std::string>& argv,
                                         std::chrono::milliseconds timeout);
+
+// Waits until pred() holds (true) or the timeout, scaled() by kTimeScale, passes (false): how a
+// multi-process test waits for an event of another process, never for a fixed time.
+template <class Pred>
+bool eventually(Pred pred, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + scaled(timeout);
+  while (!pred()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return true;
+}
 
 }  // namespace beaconloc::testing
