@@ -35,7 +35,7 @@ TEST_F(PeerLoss, TheLocalizerSaysItsDecoderDiedAndTheBridgeItsLocalizer) {
   decoder->signal(SIGKILL);  // dies without leaving: only its lapsed liveliness tells
   decoder->wait(10s);
   const auto orphaned = wait_for_diagnostics(
-      diagnostics, "beaconloc.localizer",
+      diagnostics, "beaconloc.localizer.range_ekf",
       [](const msg::Diagnostics& d) { return says(d, "no live range writer: the decoder was lost"); });
   EXPECT_TRUE(says(orphaned, "no live range writer: the decoder was lost")) << orphaned.message();
   EXPECT_EQ(orphaned.status(), msg::PARTICIPANT_STATUS_DEGRADED);
