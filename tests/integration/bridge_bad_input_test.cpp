@@ -37,22 +37,35 @@ TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
   std::vector<geometry_msgs::msg::PoseWithCovarianceStamped> poses;
   std::vector<sensor_msgs::msg::Range> ranges;
   std::size_t marker_arrays = 0;
-  bus.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+  auto* pose_reader = bus.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
       {"rt/beacon_pose", "", "rviz2.reader"}, [&](const auto& m) {
         std::lock_guard<std::mutex> lock(mutex);
         poses.push_back(m);
       });
-  bus.subscribe<sensor_msgs::msg::RangePubSubType>({"rt/beacon_ranges", "", "rviz2.reader"},
-                                                   [&](const auto& m) {
-                                                     std::lock_guard<std::mutex> lock(mutex);
-                                                     ranges.push_back(m);
-                                                   });
-  bus.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>({"rt/beacons", "", "rviz2.reader"},
-                                                                [&](const auto&) {
-                                                                  std::lock_guard<std::mutex> lock(mutex);
-                                                                  ++marker_arrays;
-                                                                });
+  auto* range_reader = bus.subscribe<sensor_msgs::msg::RangePubSubType>(
+      {"rt/beacon_ranges", "", "rviz2.reader"}, [&](const auto& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        ranges.push_back(m);
+      });
+  auto* markers_reader = bus.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>(
+      {"rt/beacons", "", "rviz2.reader"}, [&](const auto&) {
+        std::lock_guard<std::mutex> lock(mutex);
+        ++marker_arrays;
+      });
   ASSERT_TRUE(dds::wait_for_matched_readers({pose_writer, range_writer, map_writer}, scaled(10s)))
+      << bridge.log();
+  // And the bridge's ROS 2 writers matched to this test's readers: what the bridge writes before
+  // that (the ranges are volatile) would never reach them.
+  ASSERT_TRUE(eventually(
+      [&] {
+        for (auto* reader : {pose_reader, range_reader, markers_reader}) {
+          eprosima::fastdds::dds::SubscriptionMatchedStatus status;
+          reader->get_subscription_matched_status(status);
+          if (status.current_count == 0) return false;
+        }
+        return true;
+      },
+      10s))
       << bridge.log();
   const double nan = std::numeric_limits<double>::quiet_NaN();
 
