@@ -204,48 +204,59 @@ void BridgeParticipant::on_range(const msg::BeaconRange& m) {
 void BridgeParticipant::on_ros_odometry(const nav_msgs::msg::Odometry& m) {
   std::string why;
   const auto o = from_ros_odometry(m, options_.wheel_base_m, &why);
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!o) {
-    counts_.reject("odom." + why);
-    return;
+  std::lock_guard<std::mutex> order(pipeline_writes_mutex_);
+  msg::Odometry out;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!o) {
+      counts_.reject("odom." + why);
+      return;
+    }
+    const auto yaw = planar_yaw(m.pose().pose().orientation());
+    if (!yaw || !odom_.add_odom_pose(
+                    o->stamp_ns, Pose2(m.pose().pose().position().x(), m.pose().pose().position().y(), *yaw),
+                    m.twist().twist().linear().x(), m.twist().twist().angular().z())) {
+      counts_.reject("odom.bad_or_out_of_order_pose");
+      return;
+    }
+    out = dds::to_msg(options_.robot_id, *o, ++odometry_sequence_);
+    counts_.accept();
+    publish_pending_transforms();
   }
-  const auto yaw = planar_yaw(m.pose().pose().orientation());
-  if (!yaw || !odom_.add_odom_pose(
-                  o->stamp_ns, Pose2(m.pose().pose().position().x(), m.pose().pose().position().y(), *yaw),
-                  m.twist().twist().linear().x(), m.twist().twist().angular().z())) {
-    counts_.reject("odom.bad_or_out_of_order_pose");
-    return;
-  }
-  auto out = dds::to_msg(options_.robot_id, *o, ++odometry_sequence_);
-  odometry_in_writer_->write(&out);
-  counts_.accept();
-  publish_pending_transforms();
+  odometry_in_writer_->write(&out);  // not under mutex_ (see there)
 }
 
 void BridgeParticipant::on_ros_scan(const sensor_msgs::msg::LaserScan& m) {
   std::string why;
   const auto s = from_ros_scan(m, &why);
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!s) {
-    counts_.reject("scan." + why);
-    return;
+  std::lock_guard<std::mutex> order(pipeline_writes_mutex_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!s) {
+      counts_.reject("scan." + why);
+      return;
+    }
+    counts_.accept();
   }
   auto out = dds::to_msg(options_.robot_id, *s);
-  scan_in_writer_->write(&out);
-  counts_.accept();
+  scan_in_writer_->write(&out);  // not under mutex_ (see there)
 }
 
 void BridgeParticipant::on_ros_initial_pose(const geometry_msgs::msg::PoseWithCovarianceStamped& m) {
   std::string why;
   const auto init = from_initial_pose(m, &why);
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!init) {
-    counts_.reject("initialpose." + why);
-    return;
-  }
-  if (m.header().frame_id() != options_.map_frame) {
-    counts_.reject("initialpose.not_in_the_map_frame");  // no TF tree here to transform it
-    return;
+  std::lock_guard<std::mutex> order(pipeline_writes_mutex_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!init) {
+      counts_.reject("initialpose." + why);
+      return;
+    }
+    if (m.header().frame_id() != options_.map_frame) {
+      counts_.reject("initialpose.not_in_the_map_frame");  // no TF tree here to transform it
+      return;
+    }
+    counts_.accept();
   }
   msg::InitialPose out;
   out.robot_id(options_.robot_id);
@@ -254,8 +265,7 @@ void BridgeParticipant::on_ros_initial_pose(const geometry_msgs::msg::PoseWithCo
   out.y_m(init->pose_map_base.y());
   out.yaw_rad(init->pose_map_base.z());
   for (int i = 0; i < 9; ++i) out.covariance()[static_cast<std::size_t>(i)] = init->covariance(i / 3, i % 3);
-  initial_pose_writer_->write(&out);
-  counts_.accept();
+  initial_pose_writer_->write(&out);  // not under mutex_ (see there)
 }
 
 msg::Diagnostics BridgeParticipant::diagnostics_snapshot() {

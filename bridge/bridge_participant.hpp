@@ -70,7 +70,14 @@ class BridgeParticipant {
   msg::Diagnostics diagnostics_snapshot();
 
   BridgeOptions options_;
+  // The bridge's state. Never held while writing to the pipeline's own topics (the localizer's
+  // inputs: odometry, scans, initial poses): the localizer publishes poses under its lock and,
+  // in one process (`run --bridge`), a pose reaches on_pose within that write. Holding mutex_
+  // there took the two locks in opposite orders: the run deadlocked at a 2D Pose Estimate.
   std::mutex mutex_;
+  // Orders those writes (each stream's samples go out in the order they were made); taken
+  // before mutex_, never while holding it.
+  std::mutex pipeline_writes_mutex_;
   OdomFrame odom_;
   PendingTransforms pending_transforms_;  // poses newer than the odometry received so far
   RejectionCounter counts_;

@@ -21,6 +21,7 @@
 #include "beaconloc/dds/stop_signal.hpp"
 #include "decoder_participant.hpp"
 #include "diagnostics_recorder.hpp"
+#include "lead_limiter.hpp"
 #include "localizer_participant.hpp"
 #include "pose_recorder.hpp"
 #include "sim/faults.hpp"
@@ -44,6 +45,8 @@ using namespace std::chrono_literals;
 // process as fast as the machine goes loses nothing.
 constexpr std::uint64_t kMaxOdometryLead = 25;
 constexpr std::uint64_t kMaxTofLead = 8;
+// A consumer that takes nothing for this long while it lacks samples lost them on the way.
+constexpr auto kLostAfter = 2s;
 
 class ChildProcess {
  public:
@@ -216,18 +219,38 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
   DiagnosticsRecorder diagnostics(o.dds);
   std::unique_ptr<GatewayParticipant> gateway;
   std::uint64_t stalls = 0;
-  auto throttle = [&] {
-    // Hold the gateway back while the decoder or the localizer lags (speed 0: as fast as they go).
-    const auto give_up = std::chrono::steady_clock::now() + 2s;
+  // The streams the gateway is held back on, in this order: odometry (to the localizer), TOFs (to
+  // the decoder) and the decoder's ranges (to the localizer).
+  enum : std::size_t { kOdometry, kTofs, kRanges };
+  LeadLimiter lead({kMaxOdometryLead, kMaxTofLead, kMaxTofLead});
+  auto streams = [&] {
     const auto& written = gateway->progress();
-    while (written.odometry_written.load() > localizer.odometry_processed() + kMaxOdometryLead ||
-           written.tofs_written.load() > decoder.tofs_processed() + kMaxTofLead ||
-           decoder.ranges_written() > localizer.ranges_processed() + kMaxTofLead) {
-      if (std::chrono::steady_clock::now() > give_up) {
-        ++stalls;  // a sample was lost on the way: do not wait for it forever
+    return std::vector<LeadLimiter::Stream>{{written.odometry_written.load(), localizer.odometry_processed()},
+                                            {written.tofs_written.load(), decoder.tofs_processed()},
+                                            {decoder.ranges_written(), localizer.ranges_processed()}};
+  };
+  auto processed = [](const std::vector<LeadLimiter::Stream>& now) {
+    std::uint64_t n = 0;
+    for (const auto& s : now) n += s.processed;
+    return n;
+  };
+  auto throttle = [&] {
+    // Hold the gateway back while the decoder or the localizer lags (speed 0: as fast as they go),
+    // as long as they take samples: what they lack when they took none for kLostAfter was lost.
+    auto now = streams();
+    std::uint64_t taken = processed(now);
+    auto taken_at = std::chrono::steady_clock::now();
+    while (lead.lagging(now)) {
+      std::this_thread::sleep_for(50us);
+      now = streams();
+      if (processed(now) != taken) {
+        taken = processed(now);
+        taken_at = std::chrono::steady_clock::now();
+      } else if (std::chrono::steady_clock::now() - taken_at > kLostAfter) {
+        ++stalls;
+        lead.give_up(now);
         return;
       }
-      std::this_thread::sleep_for(50us);
     }
   };
   LoadedSource described{source.choice, source.seed, nullptr, source.scenario, source.label};
@@ -262,15 +285,19 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
   gateway->rethrow_failure();
   // Let the last samples through the pipeline.
   const auto drain_until = std::chrono::steady_clock::now() + 3s;
-  while (std::chrono::steady_clock::now() < drain_until &&
-         (gateway->progress().odometry_written.load() > localizer.odometry_processed() ||
-          decoder.ranges_written() > localizer.ranges_processed())) {
-    std::this_thread::sleep_for(10ms);
-  }
+  auto draining = [&] {
+    const auto now = streams();
+    return lead.missing(kOdometry, now[kOdometry]) > 0 || lead.missing(kRanges, now[kRanges]) > 0;
+  };
+  while (std::chrono::steady_clock::now() < drain_until && draining()) std::this_thread::sleep_for(10ms);
   std::this_thread::sleep_for(100ms);
   if (stalls) {
-    std::printf("run: the gateway waited for a lost sample %llu time(s)\n",
-                static_cast<unsigned long long>(stalls));
+    std::printf(
+        "run: the gateway waited for a lost sample %llu time(s); lost %llu odometry, %llu TOF, %llu range "
+        "sample(s)\n",
+        static_cast<unsigned long long>(stalls), static_cast<unsigned long long>(lead.lost(kOdometry)),
+        static_cast<unsigned long long>(lead.lost(kTofs)),
+        static_cast<unsigned long long>(lead.lost(kRanges)));
   }
   gateway->publish_diagnostics();
   decoder.publish_diagnostics();

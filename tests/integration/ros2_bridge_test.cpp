@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <thread>
 
 #include "beaconloc/core/csv_reader.hpp"
 #include "beaconloc/core/occupancy_grid_io.hpp"
@@ -47,20 +49,38 @@ struct Inbox {
   }
 };
 
-TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) {
-  DomainLease domain;
-  char dir[] = "/tmp/beaconloc-bridge-XXXXXX";
-  ASSERT_NE(::mkdtemp(dir), nullptr);
-  // Until stopped (--duration-s 0): the test owns the run's lifetime and ends it when every step
-  // below is done; a fixed duration raced them (under load the run ended before the initial
-  // pose and the late readers).
-  ChildProcess run({BEACONLOC_EXECUTABLE, "run", "--bridge", "--speed", "1", "--duration-s", "0", "--out",
-                    dir, "--domain", std::to_string(domain.id())},
-                   std::string(dir) + "/run.log");
+// `beaconloc run --bridge` in real time on a domain and in a directory of its own, and the DDS
+// options of readers and writers as ROS 2 tools create them (tests/integration/rviz2_readers.xml).
+// Until stopped (--duration-s 0): each test owns the run's lifetime and ends it when every step
+// is done; a fixed duration raced them (under load the run ended before the initial pose and the
+// late readers).
+class Ros2Bridge : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char dir[] = "/tmp/beaconloc-bridge-XXXXXX";
+    ASSERT_NE(::mkdtemp(dir), nullptr);
+    dir_ = dir;
+    run_.emplace(
+        std::vector<std::string>{BEACONLOC_EXECUTABLE, "run", "--bridge", "--speed", "1", "--duration-s", "0",
+                                 "--out", dir_, "--domain", std::to_string(domain_.id())},
+        dir_ + "/run.log");
+    options_.domain_id = domain_.id();
+    options_.extra_qos_files = {kSource + "/tests/integration/rviz2_readers.xml"};
+  }
+  void TearDown() override {
+    run_.reset();  // killed if a failed test left it running
+    std::filesystem::remove_all(dir_);
+  }
 
-  dds::DdsOptions options;
-  options.domain_id = domain.id();
-  options.extra_qos_files = {kSource + "/tests/integration/rviz2_readers.xml"};
+  DomainLease domain_;
+  std::string dir_;
+  std::optional<ChildProcess> run_;
+  dds::DdsOptions options_;
+};
+
+TEST_F(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) {
+  ChildProcess& run = *run_;
+  const dds::DdsOptions& options = options_;
   Inbox<geometry_msgs::msg::PoseWithCovarianceStamped> poses;
   Inbox<nav_msgs::msg::Odometry> odometry;
   Inbox<tf2_msgs::msg::TFMessage> tf;
@@ -186,7 +206,39 @@ TEST(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics) 
 
   run.signal(SIGTERM);
   EXPECT_TRUE(run.wait(20s));
-  std::filesystem::remove_all(dir);
+}
+
+// rviz2's 2D Pose Estimate, clicked again and again while the robot is tracked, into a run in one
+// process (`run --bridge`): the bridge hands each to the localizer while the localizer hands its
+// poses to the bridge. Every pose keeps coming and the run stops on SIGTERM. (The two once took
+// each other's locks in opposite orders: the run froze at the first 2D Pose Estimate.)
+TEST_F(Ros2Bridge, InitialPosesWhileTrackingNeverStallARunInOneProcess) {
+  ChildProcess& run = *run_;
+  const dds::DdsOptions& options = options_;
+  Inbox<geometry_msgs::msg::PoseWithCovarianceStamped> poses;
+  {
+    dds::Participant rviz(options, "test.rviz2");
+    rviz.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+        {"rt/beacon_pose", "", "rviz2.reader"}, [&](const auto& m) { poses.add(m); });
+    auto* writer = rviz.writer<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+        {"rt/initialpose", "test.initialpose.writer", ""});
+    ASSERT_TRUE(eventually([&] { return poses.size() > 50; }, 30s)) << run.log();
+    ASSERT_TRUE(dds::wait_for_matched_readers({writer}, scaled(5s)));
+    // 2 s of clicks at 100 Hz, each where the robot was last seen.
+    for (int i = 0; i < 200; ++i) {
+      auto click = poses.last();
+      writer->write(&click);
+      std::this_thread::sleep_for(10ms);
+    }
+    const std::size_t after_clicks = poses.size();
+    EXPECT_TRUE(eventually([&] { return poses.size() > after_clicks + 100; }, 20s))
+        << "the poses stopped at " << poses.size() << "\n"
+        << run.log();
+    rviz.close();
+  }
+  run.signal(SIGTERM);
+  const auto code = run.wait(30s);
+  EXPECT_TRUE(code) << "the run did not stop on SIGTERM\n" << run.log();
 }
 
 // A ROS 2 robot on Cyclone DDS (the DDS under rmw_cyclonedds in Humble and Jazzy) feeds the

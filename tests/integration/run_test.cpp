@@ -16,6 +16,11 @@ using namespace std::chrono_literals;
 
 const std::string kSource = BEACONLOC_SOURCE_DIR;
 const std::string kShared = kSource + "/../shared/datasets";
+// --speed of the runs with one process per participant, which cannot hold the gateway back: four
+// times real time in Release; real time under the sanitizers, where an instrumented localizer
+// takes half a core at twice real time (the UKF), more than a loaded 2-core machine always gives
+// it: it fell behind, lost samples and refused scans ahead of its odometry.
+const std::string kProcessesSpeed = kTimeScale > 1 ? "1" : "4";
 
 std::string read(const std::string& path) {
   std::ifstream in(path);
@@ -151,11 +156,11 @@ TEST_F(Run, AccuracyOverRunsThatGaveNothingFails) {
 
 TEST_F(Run, OneProcessPerParticipant) {
   const auto [code, out] =
-      beaconloc({"run", "--processes", "--speed", "4", "--duration-s", "12", "--out", dir_});
+      beaconloc({"run", "--processes", "--speed", kProcessesSpeed, "--duration-s", "12", "--out", dir_});
   ASSERT_EQ(code, 0) << out;
   const std::string metrics = read(dir_ + "/metrics.json");
-  EXPECT_GT(json_number(metrics, "samples"), 800);
-  EXPECT_LT(json_number(metrics, "position_rms_m"), 0.15);
+  EXPECT_GT(json_number(metrics, "samples"), 800) << out;
+  EXPECT_LT(json_number(metrics, "position_rms_m"), 0.15) << out;
   EXPECT_TRUE(std::filesystem::exists(dir_ + "/localizer.log"));
 }
 
@@ -163,15 +168,13 @@ TEST_F(Run, OneProcessPerParticipant) {
 // reach the UKF over the topics, the map as a map_server file named on the localizer's command
 // line (written from the scenario), the start pose as the paper's hand placement.
 TEST_F(Run, UkfFusesLaserAndAnonymousBeaconsAcrossProcesses) {
-  // Four times real time; under the sanitizers, as much slower as the instrumented processes are.
-  const std::string speed = std::to_string(4.0 / kTimeScale);
-  const auto [code, out] = beaconloc({"run", "--processes", "--speed", speed, "--duration-s", "20",
+  const auto [code, out] = beaconloc({"run", "--processes", "--speed", kProcessesSpeed, "--duration-s", "20",
                                       "--scenario", kSource + "/examples/scenarios/seed001_classroom.yaml",
                                       "--estimator", "ukf_lrf", "--out", dir_});
   ASSERT_EQ(code, 0) << out;
   const std::string metrics = read(dir_ + "/metrics.json");
-  EXPECT_GT(json_number(metrics, "samples"), 700);           // 20 s of 22 ms odometry steps: ~900
-  EXPECT_LT(json_number(metrics, "position_rms_m"), 0.101);  // the paper's Table 6, fusion
+  EXPECT_GT(json_number(metrics, "samples"), 700) << out;           // 20 s of 22 ms odometry steps: ~900
+  EXPECT_LT(json_number(metrics, "position_rms_m"), 0.101) << out;  // the paper's Table 6, fusion
   EXPECT_TRUE(std::filesystem::exists(dir_ + "/map.yaml"));
   EXPECT_TRUE(std::filesystem::exists(dir_ + "/map.pgm"));
   // Every beacon range decoded (the scenario's 15 m limit reached the decoder), none refused; the
