@@ -173,13 +173,9 @@ void BridgeParticipant::on_odometry(const msg::Odometry& m) {
 }
 
 void BridgeParticipant::on_beacon_map(const msg::BeaconMap& m) {
-  BeaconMapCheck check;
-  const std::optional<BeaconMap> map = BeaconMap::from(dds::from_msg(m), &check);
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!map) {
-    counts_.reject(std::string("beacon_map.") + to_string(check.problem));
-    return;
-  }
+  const std::optional<BeaconMap> map = counted_beacon_map(dds::from_msg(m), counts_);
+  if (!map) return;
   auto markers = beacon_markers(*map, options_.map_frame, dds::wall_clock_ns());
   beacons_writer_->write(&markers);
 }

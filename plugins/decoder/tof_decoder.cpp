@@ -94,13 +94,8 @@ DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample
 }
 
 std::vector<DecodedRange> TofDecoder::on_beacon_map(const std::vector<Beacon>& beacons) {
-  BeaconMapCheck check;
-  const std::optional<BeaconMap> map = BeaconMap::from(beacons, &check);
-  if (!map) {
-    counts_.reject(std::string("beacon_map.") + to_string(check.problem));
-    return {};
-  }
-  return set_beacon_map(*map);
+  const std::optional<BeaconMap> map = counted_beacon_map(beacons, counts_);
+  return map ? set_beacon_map(*map) : std::vector<DecodedRange>{};
 }
 
 std::vector<DecodedRange> TofDecoder::set_beacon_map(const BeaconMap& map) {

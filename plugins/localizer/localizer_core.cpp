@@ -13,14 +13,9 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
 }
 
 bool LocalizerCore::on_beacon_map(const std::vector<Beacon>& beacons) {
-  BeaconMapCheck check;
-  const std::optional<BeaconMap> map = BeaconMap::from(beacons, &check);
-  if (!map) {
-    counts_.reject(std::string("beacon_map.") + to_string(check.problem));
-    return false;
-  }
-  set_beacon_map(*map);
-  return true;
+  const std::optional<BeaconMap> map = counted_beacon_map(beacons, counts_);
+  if (map) set_beacon_map(*map);
+  return map.has_value();
 }
 
 void LocalizerCore::set_beacon_map(const BeaconMap& map) {

@@ -10,11 +10,9 @@ std::vector<const PoseWriter*> RobotPoses::current_writers(std::chrono::steady_c
   return out;
 }
 
-bool is_finite(const PoseEstimate& e) { return e.pose_map_base.allFinite() && e.covariance.allFinite(); }
-
 PoseTally::Added PoseTally::add(const RecordedPose& p, const std::string& writer) {
   RobotPoses& r = robots_[p.row.robot_id];
-  if (!is_finite(p.row.estimate)) {
+  if (!publishable(p.row.estimate)) {
     ++r.non_finite;
     return Added::kNonFinite;
   }

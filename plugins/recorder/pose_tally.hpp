@@ -32,14 +32,12 @@ struct PoseWriter {
 struct RobotPoses {
   std::optional<RecordedPose> newest;  // finite; none while every pose was refused
   std::uint64_t poses = 0;       // finite poses, a writer's correction at its pose's stamp not counted again
-  std::uint64_t non_finite = 0;  // refused: a non-finite position, heading or covariance
+  std::uint64_t non_finite = 0;  // refused: not publishable() (a non-finite number, a broken covariance)
   std::map<std::string, PoseWriter> writers;  // by writer id (one per localizer)
   bool had_conflict = false;                  // two writers at once, ever
   // The writers heard within kConcurrentWritersWithin before `now`: more than one is a conflict.
   std::vector<const PoseWriter*> current_writers(std::chrono::steady_clock::time_point now) const;
 };
-
-bool is_finite(const PoseEstimate& e);
 
 class PoseTally {
  public:

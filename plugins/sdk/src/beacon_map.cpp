@@ -63,6 +63,13 @@ std::optional<BeaconMap> BeaconMap::from(const std::vector<Beacon>& beacons, Bea
   return BeaconMap(beacons);
 }
 
+std::optional<BeaconMap> counted_beacon_map(const std::vector<Beacon>& beacons, RejectionCounter& counts) {
+  BeaconMapCheck check;
+  std::optional<BeaconMap> map = BeaconMap::from(beacons, &check);
+  if (!map) counts.reject(std::string("beacon_map.") + to_string(check.problem));
+  return map;
+}
+
 bool BeaconMap::operator==(const BeaconMap& other) const {
   if (beacons_.size() != other.beacons_.size()) return false;
   for (auto a = beacons_.begin(), b = other.beacons_.begin(); a != beacons_.end(); ++a, ++b) {

@@ -15,6 +15,7 @@
 
 #include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/measurements.hpp"
+#include "beaconloc/core/rejection_counter.hpp"
 
 namespace beaconloc {
 
@@ -86,5 +87,9 @@ class BeaconMap {
  private:
   std::map<std::uint32_t, Beacon> beacons_;  // ordered: deterministic iteration
 };
+
+// How every participant takes a map from the bus: the map, or nullopt with the refusal counted
+// in `counts` as beacon_map.<reason> (the caller keeps the map it has).
+std::optional<BeaconMap> counted_beacon_map(const std::vector<Beacon>& beacons, RejectionCounter& counts);
 
 }  // namespace beaconloc
