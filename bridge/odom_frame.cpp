@@ -2,7 +2,9 @@
 
 #include <cmath>
 
+#include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/models/diff_drive_motion.hpp"
+#include "beaconloc/core/odometry_timeline.hpp"
 
 namespace beaconloc::bridge {
 
@@ -13,26 +15,34 @@ bool OdomFrame::push(StampNs stamp_ns, const Pose2& pose) {
   return true;
 }
 
-bool OdomFrame::add_wheel_odometry(const OdometrySample& o) {
-  if (!(o.wheel_base_m > 0.0) || !std::isfinite(o.wheel_velocity_right_mps) ||
-      !std::isfinite(o.wheel_velocity_left_mps)) {
-    return false;
-  }
+InputResult OdomFrame::add_wheel_odometry(const OdometrySample& o) {
+  // The estimators' checks: an absurd speed integrated here would put odom -> base_link, and the
+  // twist the bridge publishes, at infinity.
+  if (InputResult checked = check_odometry_numbers(o); !checked.accepted) return checked;
   Pose2 pose = Pose2::Zero();
   if (!poses_.empty()) {
-    if (o.stamp_ns <= poses_.back().first) return false;
+    if (o.stamp_ns <= poses_.back().first) return InputResult::rejected("out_of_order_odometry");
     const double dt = static_cast<double>(o.stamp_ns - poses_.back().first) * 1e-9;
     pose = predict_diff_drive(poses_.back().second, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
                               o.wheel_base_m, dt)
                .pose;
   }
+  // Bounded speeds over any gap keep the pose finite; beyond a site's extent it says nothing.
+  if (!within_site(pose)) return InputResult::rejected("implausible_odom_pose");
   v_mps_ = (o.wheel_velocity_right_mps + o.wheel_velocity_left_mps) / 2.0;
   omega_radps_ = (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / o.wheel_base_m;
-  return push(o.stamp_ns, pose);
+  push(o.stamp_ns, pose);
+  return InputResult::ok();
+}
+
+bool OdomFrame::within_site(const Pose2& pose) {
+  return pose.allFinite() && pose.head<2>().cwiseAbs().maxCoeff() <= kMaxMapCoordinateM &&
+         std::abs(pose.z()) <= kMaxAngleRad;
 }
 
 bool OdomFrame::add_odom_pose(StampNs stamp_ns, const Pose2& pose, double v_mps, double omega_radps) {
-  if (!pose.allFinite() || !push(stamp_ns, pose)) return false;
+  if (!within_site(pose) || !std::isfinite(v_mps) || !std::isfinite(omega_radps) || !push(stamp_ns, pose))
+    return false;
   v_mps_ = v_mps;
   omega_radps_ = omega_radps;
   return true;

@@ -6,6 +6,7 @@
 #include <deque>
 #include <optional>
 
+#include "beaconloc/core/estimator.hpp"
 #include "beaconloc/core/measurements.hpp"
 #include "beaconloc/core/pose2.hpp"
 
@@ -15,9 +16,10 @@ class OdomFrame {
  public:
   explicit OdomFrame(StampNs history_ns = 2'000'000'000) : history_ns_(history_ns) {}
   // Integrates wheel velocities (eq. 14 of seed 000) from the previous sample; the first sample
-  // anchors the frame at the origin. Out-of-order samples are refused (false).
-  bool add_wheel_odometry(const OdometrySample& o);
-  // A driver's own odom -> base pose, and its twist.
+  // anchors the frame at the origin. Refused with the estimators' reasons (check_odometry_numbers),
+  // out_of_order_odometry, or implausible_odom_pose (beyond a site's extent).
+  InputResult add_wheel_odometry(const OdometrySample& o);
+  // A driver's own odom -> base pose (finite, within a site's extent), and its finite twist.
   bool add_odom_pose(StampNs stamp_ns, const Pose2& pose_odom_base, double v_mps, double omega_radps);
   // odom -> base at stamp_ns, interpolated between neighbours; nullopt outside the history.
   std::optional<Pose2> pose_odom_base(StampNs stamp_ns) const;
@@ -33,6 +35,7 @@ class OdomFrame {
 
  private:
   bool push(StampNs stamp_ns, const Pose2& pose);
+  static bool within_site(const Pose2& pose);
   StampNs history_ns_;
   std::deque<std::pair<StampNs, Pose2>> poses_;
   double v_mps_ = 0.0;

@@ -1,5 +1,7 @@
 #include "ros2_convert.hpp"
 
+#include "beaconloc/core/odometry_timeline.hpp"
+
 #include <cmath>
 
 namespace beaconloc::bridge {
@@ -9,7 +11,7 @@ constexpr int kPlanarIndex[3] = {0, 1, 5};  // x, y, yaw in (x, y, z, roll, pitc
 
 // A conversion's refusal: the reason, for the caller to count, and nothing converted.
 template <class T>
-std::optional<T> refused(std::string* why_not, const char* reason) {
+std::optional<T> refused(std::string* why_not, const std::string& reason) {
   if (why_not) *why_not = reason;
   return std::nullopt;
 }
@@ -118,6 +120,11 @@ std::optional<OdometrySample> from_ros_odometry(const nav_msgs::msg::Odometry& m
   Eigen::Matrix2d j;
   j << 1.0, wheel_base_m / 2.0, 1.0, -wheel_base_m / 2.0;
   o.wheel_velocity_covariance = j * Eigen::Vector2d(var_v, var_omega).asDiagonal() * j.transpose();
+  // What the localizer would refuse is refused here, by the same checks and reasons: a huge
+  // finite twist is an infinite wheel speed on the bus.
+  if (const InputResult checked = check_odometry_numbers(o); !checked.accepted) {
+    return refused<OdometrySample>(why_not, checked.rejection);
+  }
   return o;
 }
 

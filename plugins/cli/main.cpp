@@ -30,7 +30,6 @@ using namespace std::chrono_literals;
 // The ranges of the numeric options (number_options.hpp validates every one): the physical
 // limits of core/limits.hpp where the option is one of those quantities.
 constexpr bool kOpen = true;         // (min, max]: the option must be > min
-constexpr double kMaxSpeed = 1e6;    // --speed: data seconds per wall-clock second
 constexpr double kMaxAgeMs = 6e4;    // --max-age-ms: a TOF's useful life, at most a minute
 constexpr double kMaxDelayMs = 1e4;  // --delay-ms of accuracy runs
 
@@ -66,7 +65,7 @@ void add_gateway_options(CLI::App* app, GatewayOptions& o, std::optional<std::ui
                   "seconds of data to run (0: a recording to its end, a simulation until stopped)")
       ->transform(real_in(0.0, kMaxDurationS));
   app->add_option("--speed", o.speed, "data seconds per wall-clock second")
-      ->transform(real_in(0.0, kMaxSpeed, kOpen));
+      ->transform(real_in(GatewayOptions::kMinSpeed, GatewayOptions::kMaxSpeed));  // the gateway's own bounds
   app->add_option("--seed", seed, "random seed of the simulated noise (default: the scenario's)")
       ->transform(any_unsigned());
   app->add_option("--truth-out", o.truth_csv, "write ground truth CSV here");
@@ -275,7 +274,10 @@ int run(int argc, char** argv) {
   monitor->add_option("--out", estimate_file, "write every pose to this CSV at the end");
 
   CLI11_PARSE(app, argc, argv);
-  dds::install_stop_handlers();
+  // The commands that run participants poll the stop flag and stop cleanly (their DDS entities
+  // and shared-memory files released). The offline ones (eval, accuracy) poll nothing and hold
+  // no DDS entity: a stop signal keeps its default action and ends them at once.
+  if (!eval->parsed() && !accuracy->parsed()) dds::install_stop_handlers();
   decoder_config.max_age_ns = static_cast<StampNs>(max_age_ms * 1e6);
 
   try {

@@ -112,7 +112,7 @@ int run_monitor(const MonitorOptions& o) {
   }
   const PoseRunSummary s = summarize(recorded, load_truth_csv(o.truth_file));
   std::printf("poses: %zu at %.1f Hz; %s\n", s.poses, s.pose_rate_hz, format_metrics(s.metrics).c_str());
-  return 0;
+  return s.metrics.samples ? 0 : 1;  // poses, but none at a stamp the truth covers: nothing scored
 }
 
 }  // namespace beaconloc::cli

@@ -69,6 +69,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
                                                           const OdometrySample& odometry) {
   Robot* r = robot(robot_id, "odometry");
   if (!r) return std::nullopt;
+  r->odometry_silent = false;  // the bus delivers odometry again
   InputResult result = r->fusion.predict(odometry);
   for (const auto& reason : r->fusion.take_deferred_rejections()) counts_.reject("deferred." + reason);
   if (!result.accepted && result.rejection == "out_of_order_odometry" && clock_jumped_back(*r, odometry)) {
@@ -186,6 +187,19 @@ void LocalizerCore::on_ranges_silent(const std::string& robot_id) {
   if (it != robots_.end()) it->second.ranges_silent = true;
 }
 
+void LocalizerCore::on_odometry_silent(const std::string& robot_id) {
+  auto it = robots_.find(robot_id);
+  if (it != robots_.end()) it->second.odometry_silent = true;
+}
+
+std::vector<std::string> LocalizerCore::odometry_silent_robots() const {
+  std::vector<std::string> ids;
+  for (const auto& [id, r] : robots_) {
+    if (r.odometry_silent) ids.push_back(id);
+  }
+  return ids;
+}
+
 std::vector<std::string> LocalizerCore::robot_ids() const {
   std::vector<std::string> ids;
   ids.reserve(robots_.size());
@@ -219,7 +233,8 @@ PoseStatus LocalizerCore::Robot::status() const {
   const PoseStatus estimator_status = fusion.estimator().status();
   // Silent ranges make a good pose degraded at once, rather than after the estimator's own
   // 1 s of data time without a fused range.
-  if (ranges_silent && severity(estimator_status) < severity(PoseStatus::kDegraded))
+  // Silent odometry: the pose stands still while the robot may move.
+  if ((ranges_silent || odometry_silent) && severity(estimator_status) < severity(PoseStatus::kDegraded))
     return PoseStatus::kDegraded;
   return estimator_status;
 }

@@ -55,6 +55,13 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
   odometry_events.deadline_misses = &deadline_misses_;
   odometry_events.writers_lost = &odometry_writers_lost_;
   odometry_events.lost_and_none_alive = &odometry_writer_lost_;
+  // A gateway that stopped or hung (its liveliness is asserted by a task of its own, so a hung run
+  // loop still looks alive) shows as a missed deadline: the robot is degraded until odometry
+  // flows again.
+  odometry_events.on_deadline_missed = [this](const msg::Odometry& key) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    core_.on_odometry_silent(key.robot_id());
+  };
   participant_.subscribe<msg::OdometryPubSubType>(
       dds::kOdometryTopic, [this](const msg::Odometry& m) { on_odometry(m); }, odometry_events);
   if (core_.uses_laser()) {
@@ -115,11 +122,15 @@ void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
     if (core_.serves(m.robot_id())) {
       auto [last, first] = odometry_sequence_.try_emplace(m.robot_id(), m.sequence_number());
       const std::uint64_t seq = m.sequence_number();
-      if (!first && seq > last->second) {
+      const std::uint64_t distance = seq > last->second ? seq - last->second : last->second - seq;
+      if (!first && distance > kSequenceRestart) {
+        // Far back (a restarted gateway numbering from 0 again) or far ahead (another writer, a
+        // corrupted number): a new numbering, not that many lost samples.
+        last->second = seq;
+        ++sequence_restarts_;
+      } else if (!first && seq > last->second) {
         lost_increments_ += seq - last->second - 1;
         last->second = seq;
-      } else if (!first && seq + kSequenceRestart < last->second) {
-        last->second = seq;  // far back: a restarted gateway numbering from 0 again
       }
     }
     if (auto out = core_.on_odometry(m.robot_id(), dds::from_msg(m))) publish(*out);
@@ -157,6 +168,10 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   } else if (range_writer_lost_.load()) {
     status = msg::PARTICIPANT_STATUS_DEGRADED;
     message = "no live range writer: the decoder was lost";
+  } else if (const auto silent = core_.odometry_silent_robots(); !silent.empty()) {
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message = "no odometry within its deadline for " + std::to_string(silent.size()) + " robot(s), first " +
+              silent.front() + ": the gateway stopped or hung";
   } else if (core_.robot_count() == 0) {
     status = msg::PARTICIPANT_STATUS_DEGRADED;
     message = "no robot heard yet (no odometry)";
@@ -185,6 +200,7 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   }
   RejectionCounter counts = core_.counts();
   counts.reject("odometry.lost_increment", lost_increments_);
+  counts.reject("odometry.sequence_restart", sequence_restarts_);
   counts.reject("diagnostics.too_many_robots", peer_reports_refused_);
   auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, deadline_misses_.load(),
                                  status, message);

@@ -50,8 +50,10 @@ class LocalizerParticipant {
   std::atomic<std::uint64_t> deadline_misses_{0};
   std::atomic<std::uint64_t> odometry_writers_lost_{0};
   std::map<std::string, std::uint64_t> odometry_sequence_;  // newest sequence number per robot
-  static constexpr std::uint64_t kSequenceRestart = 1000;   // 10 s of odometry back: a new writer
-  std::uint64_t lost_increments_ = 0;                       // sequence numbers never received
+  // 10 s of odometry back or ahead: a new numbering (a restarted or another writer), not losses.
+  static constexpr std::uint64_t kSequenceRestart = 1000;
+  std::uint64_t lost_increments_ = 0;    // sequence numbers never received
+  std::uint64_t sequence_restarts_ = 0;  // jumps beyond kSequenceRestart
   std::atomic<bool> odometry_writer_lost_{false};           // lost, none alive since
   std::atomic<std::uint64_t> range_writers_lost_{0};        // the decoder's beacon_range writer
   std::atomic<bool> range_writer_lost_{false};              // lost, none alive since

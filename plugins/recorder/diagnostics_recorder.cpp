@@ -24,6 +24,18 @@ const char* to_string(Liveness l) {
   return "gone";
 }
 
+const char* to_string(msg::ParticipantStatus s) {
+  switch (s) {
+    case msg::PARTICIPANT_STATUS_OK:
+      return "ok";
+    case msg::PARTICIPANT_STATUS_DEGRADED:
+      return "degraded";
+    case msg::PARTICIPANT_STATUS_ERROR:
+      return "error";
+  }
+  return "error";  // never: dds::CheckedType refuses a status the IDL does not define
+}
+
 Liveness liveness_of(InstanceStateKind state, std::chrono::nanoseconds age) {
   if (state == NOT_ALIVE_DISPOSED_INSTANCE_STATE) return Liveness::kStopped;
   if (state == NOT_ALIVE_NO_WRITERS_INSTANCE_STATE) return Liveness::kGone;
@@ -83,11 +95,10 @@ std::map<std::string, msg::Diagnostics> DiagnosticsRecorder::latest() const {
 }
 
 void print_report(const std::string& name, const ParticipantReport& r, std::ostream& out) {
-  static const char* kStatus[] = {"ok", "degraded", "error"};
   const auto& d = r.last;
   out << name << ": ";
   if (r.liveness == Liveness::kAlive) {
-    out << kStatus[static_cast<int>(d.status()) % 3] << ", ";
+    out << to_string(d.status()) << ", ";
   } else {
     const long heard_s_ago = static_cast<long>(r.heard_s_ago);
     if (r.liveness == Liveness::kSilent) {

@@ -27,6 +27,7 @@ enum class Liveness {
   kGone,     // no live writer: it exited without a word, was killed, or lost its liveliness
 };
 const char* to_string(Liveness l);
+const char* to_string(msg::ParticipantStatus s);
 
 struct ParticipantReport {
   msg::Diagnostics last;  // its newest report

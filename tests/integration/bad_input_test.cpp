@@ -146,6 +146,10 @@ TEST_F(BadInput, LocalizerRefusesEveryBadSampleByReason) {
   auto after_gap = odometry("robot1", t, 3);  // three sequence numbers never sent
   odometry_writer->write(&after_gap);
   ++good_odometry;
+  t += 10 * kNsPerMillisecond;
+  auto far_ahead = odometry("robot1", t, std::uint64_t{1} << 62);  // a new numbering, not 2^62 losses
+  odometry_writer->write(&far_ahead);
+  ++good_odometry;
   // The ranges are judged against the odometry: it is all taken first (one reader, in order: the
   // last sample, good, makes the count).
   const auto odometry_taken =
@@ -176,6 +180,10 @@ TEST_F(BadInput, LocalizerRefusesEveryBadSampleByReason) {
       range(t - 2 * kNsPerSecond, id, 0, 2.1),     // older than the 600 ms it may be late
       range(t + 3 * kNsPerSecond, id, 0, 2.1),     // a clock jump ahead of the odometry
   };
+  // An association the IDL does not define: dropped at the reader's door (dds::CheckedType), not
+  // read as identified. Sent before the last one, which the wait below needs.
+  ranges.insert(ranges.end() - 1, range(t, id, 0, 2.1));
+  (ranges.end() - 2)->association(static_cast<msg::RangeAssociation>(7));
   for (auto& m : ranges) range_writer->write(&m);
 
   // One reader takes the ranges in order: the last one counts as ahead_of_odometry.
@@ -190,6 +198,8 @@ TEST_F(BadInput, LocalizerRefusesEveryBadSampleByReason) {
   EXPECT_EQ(rejected_count(d, "odometry.invalid_wheel_base"), 1u);
   EXPECT_EQ(rejected_count(d, "odometry.other_robot"), 1u);
   EXPECT_EQ(rejected_count(d, "odometry.lost_increment"), 3u);
+  EXPECT_EQ(rejected_count(d, "odometry.sequence_restart"), 1u);
+  EXPECT_GE(rejected_count(d, "undecodable_sample"), 1u);
   EXPECT_EQ(rejected_count(d, "range.non_finite_range"), 1u);
   EXPECT_EQ(rejected_count(d, "range.invalid_range"), 1u);
   EXPECT_EQ(rejected_count(d, "range.unknown_beacon"), 1u);

@@ -6,6 +6,8 @@
 // UDP-only loopback profile (a killed process cannot remove shared-memory segments).
 #include <beaconlocPubSubTypes.h>
 #include <gtest/gtest.h>
+
+#include <fstream>
 #include <signal.h>
 
 #include <chrono>
@@ -334,6 +336,31 @@ TEST_F(Monitor, WithOutTheMonitorWritesEveryPoseAndNoNonFiniteNumber) {
   const auto rows = load_estimates_csv(path("poses.csv"));
   EXPECT_EQ(rows.size(), 500u);
   for (const auto& r : rows) EXPECT_TRUE(publishable(r.estimate)) << r.robot_id << ' ' << r.estimate.stamp_ns;
+}
+
+// monitor --truth with poses of which none lies where the truth has a stamp: "not scored", and a
+// failure (exit 1), as `run` fails; never a 0 m figure, never success.
+TEST_F(Monitor, WithTruthThatCoversNoPoseItScoresNothingAndFails) {
+  {
+    std::ofstream truth(path("truth.csv"));
+    truth << "stamp_ns,x_m,y_m,yaw_rad\n";
+    for (int i = 0; i < 100; ++i) truth << (1000 + i) * kNsPerSecond << ",0,0,0\n";  // 1000 s on
+  }
+  ChildProcess monitor(command("monitor", {"--truth", path("truth.csv")}), path("monitor.log"));
+  dds::Participant bus(dds_, "test.localizer");
+  auto* writer = bus.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic);
+  ASSERT_TRUE(dds::wait_for_matched_readers({writer}, scaled(15s))) << monitor.log();
+  std::vector<msg::PoseEstimate> sent;
+  for (int i = 1; i <= 50; ++i) sent.push_back(pose("ra", i * 10 * kNsPerMillisecond, 0.01 * i));
+  ASSERT_NO_FATAL_FAILURE(write_acknowledged(writer, sent));
+  ASSERT_TRUE(wait_until([&] { return monitor.log().find("ra test_estimator: 50 poses") != std::string::npos; }, 15s))
+      << monitor.log();
+  monitor.signal(SIGTERM);
+  const auto code = monitor.wait(20s);
+  ASSERT_TRUE(code) << monitor.log();
+  EXPECT_EQ(*code, 1) << monitor.log();
+  EXPECT_NE(monitor.log().find("not scored"), std::string::npos) << monitor.log();
+  EXPECT_EQ(monitor.log().find("RMS"), std::string::npos) << monitor.log();
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // A participant whose peers died says so in its status (issue 23): the localizer when the
-// decoder is killed, the bridge when the localizer is.
+// decoder is killed or the gateway hangs, the bridge when the localizer is.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -47,6 +47,25 @@ TEST_F(PeerLoss, TheLocalizerSaysItsDecoderDiedAndTheBridgeItsLocalizer) {
   EXPECT_TRUE(says(silent, "the localizer is gone or silent")) << silent.message();
   EXPECT_EQ(silent.status(), msg::PARTICIPANT_STATUS_DEGRADED);
   stop_cleanly(bridge, "bridge");
+  stop_cleanly(gateway, "gateway");
+}
+
+// A gateway that is alive but sends no odometry (hung in its run loop, or paced far slower than
+// real time: its liveliness is asserted by a task of its own) is told by the odometry's deadline
+// alone: the localizer reports the robot's odometry silent and is degraded.
+TEST_F(PeerLoss, TheLocalizerSaysWhenALiveGatewaySendsNoOdometry) {
+  DiagnosticsRecorder diagnostics(dds_);
+  ChildProcess localizer(command("localizer"), path("localizer.log"));
+  wait_for_diagnostics(diagnostics, "beaconloc.localizer.range_ekf", [](const msg::Diagnostics&) { return true; });
+  // A step now and then, 10 s of wall time per 10 ms odometry period: alive, and silent.
+  ChildProcess gateway(command("gateway", {"--speed", "0.001"}), path("gateway.log"));
+  const auto silent = wait_for_diagnostics(diagnostics, "beaconloc.localizer.range_ekf", [](const msg::Diagnostics& d) {
+    return says(d, "no odometry within its deadline");
+  });
+  EXPECT_TRUE(says(silent, "no odometry within its deadline for 1 robot(s), first robot1")) << silent.message();
+  EXPECT_EQ(silent.status(), msg::PARTICIPANT_STATUS_DEGRADED);
+  EXPECT_FALSE(says(silent, "the gateway was lost")) << silent.message();  // it is alive
+  stop_cleanly(localizer, "localizer");
   stop_cleanly(gateway, "gateway");
 }
 

@@ -141,5 +141,33 @@ TEST(OutOfSequenceFusion, ARestartIsNotUndoneByMeasurementsFromBeforeIt) {
   EXPECT_EQ(fusion.estimator().estimate()->pose_map_base, Pose2(1.0, 0.5, 0.2));
 }
 
+// An initial pose that arrives before any odometry carries a stamp of another clock: it is placed
+// when the robot's time line begins, so a stamp far ahead (or behind) cannot decide how long the
+// pose counts as fresh. Every estimator that can be placed goes degraded once no range has come
+// for its staleness time, whatever the stamp; a negative stamp is refused.
+TEST(OutOfSequenceFusion, APoseGivenBeforeOdometryAgesOnTheRobotsClockNotOnItsStamp) {
+  for (const std::string name : {"range_ekf", "duhl", "ukf_lrf_beacons_only"}) {
+    for (const StampNs stamp_ns : {StampNs{0}, StampNs{1'000'000'000'000'000'000}, 5 * kNsPerSecond}) {
+      EstimatorConfig config;
+      config.receivers = sim::default_scenario().receivers;
+      if (name == "ukf_lrf_beacons_only") config.receivers.receivers_base_m.resize(1);  // one receiver (seed 001)
+      OutOfSequenceFusion fusion(EstimatorRegistry::instance().create(name, config));
+      fusion.set_beacon_map(BeaconMap(sim::default_scenario().beacons));
+      EXPECT_EQ(fusion.reset(-1, Pose2(1.0, 0.5, 0.2), 1e-4 * Cov3::Identity()).rejection, "invalid_stamp");
+      ASSERT_TRUE(fusion.reset(stamp_ns, Pose2(1.0, 0.5, 0.2), 1e-4 * Cov3::Identity()).accepted) << name;
+      const StampNs start_ns = 100 * kNsPerSecond;
+      for (StampNs t = start_ns; t <= start_ns + 20 * kNsPerSecond; t += 10 * kNsPerMillisecond) {
+        fusion.predict(still_odometry(t));
+        const auto e = fusion.estimator().estimate();
+        ASSERT_TRUE(e) << name << " at " << t;
+        EXPECT_LT((e->pose_map_base - Pose2(1.0, 0.5, 0.2)).norm(), 1e-6) << name;
+        if (t - start_ns > 2 * kNsPerSecond) {
+          ASSERT_NE(e->status, PoseStatus::kOk) << name << ", stamp " << stamp_ns << ", at " << t;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace beaconloc

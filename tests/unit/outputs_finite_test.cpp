@@ -54,6 +54,9 @@ TEST_F(OutputsFinite, EvaluationRefusesANonFiniteEstimate) {
   TruthTrack truth;
   for (StampNs t = 0; t < 5; ++t) truth.add(t, Pose2::Zero());
   EXPECT_THROW(evaluate(truth, rows_with(std::numeric_limits<double>::quiet_NaN())), std::invalid_argument);
+  // Finite but beyond any site (publishable()): its squared error overflowed the RMS to inf.
+  EXPECT_THROW(evaluate(truth, rows_with(1e200)), std::invalid_argument);
+  EXPECT_THROW(write_estimates_csv(dir_ + "/far.csv", rows_with(1e200)), std::invalid_argument);
   EXPECT_EQ(evaluate(truth, rows_with(0.5)).samples, 3u);
 }
 

@@ -92,6 +92,20 @@ TEST(Ros2Bridge, DriverOdometryBecomesWheelSpeedsAndBadOnesAreRefused) {
   m.twist().twist().linear().x(std::nan(""));
   EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
   EXPECT_EQ(why, "non_finite_twist");
+  // Finite but absurd: refused as the localizer refuses it, not sent on as inf wheel speeds.
+  for (double v : {1e300, 1000.0, 10.5}) {
+    m.twist().twist().linear().x(v);
+    EXPECT_FALSE(from_ros_odometry(m, 0.4, &why)) << v;
+    EXPECT_EQ(why, "implausible_wheel_speed") << v;
+  }
+  m.twist().twist().linear().x(0.5);
+  m.twist().twist().angular().z(1e300);
+  EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
+  EXPECT_EQ(why, "implausible_wheel_speed");
+  m.twist().twist().angular().z(0.2);
+  m.twist().covariance()[0] = 1e300;
+  EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
+  EXPECT_EQ(why, "invalid_odometry_covariance");
   sensor_msgs::msg::LaserScan scan;
   EXPECT_FALSE(from_ros_scan(scan, &why));
   EXPECT_EQ(why, "bad_stamp");  // zero: ROS's "no stamp"
@@ -114,14 +128,23 @@ TEST(Ros2Bridge, MapToOdomComposesToTheEstimate) {
   OdometrySample o;
   o.wheel_base_m = 0.4;
   o.stamp_ns = 0;
-  ASSERT_TRUE(odom.add_wheel_odometry(o));  // anchor: odom -> base = identity at t = 0
+  ASSERT_TRUE(odom.add_wheel_odometry(o).accepted);  // anchor: odom -> base = identity at t = 0
   o.wheel_velocity_right_mps = 0.6;
   o.wheel_velocity_left_mps = 0.4;
   for (int k = 1; k <= 100; ++k) {
     o.stamp_ns = k * 10'000'000;
-    ASSERT_TRUE(odom.add_wheel_odometry(o));
+    ASSERT_TRUE(odom.add_wheel_odometry(o).accepted);
   }
-  EXPECT_FALSE(odom.add_wheel_odometry(o));  // same stamp again: refused
+  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, "out_of_order_odometry");  // same stamp again
+  // The bus's odometry is checked as the estimators check it: an absurd speed never moves the
+  // frame (it put odom -> base_link and the published twist at infinity).
+  for (double v : {1e300, 1000.0}) {
+    o.stamp_ns += 10'000'000;
+    o.wheel_velocity_right_mps = v;
+    EXPECT_EQ(odom.add_wheel_odometry(o).rejection, "implausible_wheel_speed") << v;
+  }
+  EXPECT_EQ(*odom.latest_stamp_ns(), 1'000'000'000);
+  EXPECT_NEAR(odom.v_mps(), 0.5, 1e-12);
   const Pose2 map_base(3.0, 1.0, 0.4);
   const auto map_odom = odom.pose_map_odom(1'000'000'000, map_base);
   ASSERT_TRUE(map_odom);

@@ -146,11 +146,22 @@ TEST(UkfLrfEstimator, IsRegisteredInItsThreeModesAndRefusesWhatItCannotUse) {
   auto placed = EstimatorRegistry::instance().create("ukf_lrf", config);
   LaserScanSample bad;
   EXPECT_EQ(placed->update_laser(bad).rejection, "malformed_scan");  // no beams
-  RangeMeasurement nan_range;
-  nan_range.range_m = std::nan("");
-  EXPECT_EQ(placed->update(nan_range).rejection, "invalid_range");
+  // A range's numbers are checked as every estimator checks them (check_range_numbers).
+  RangeMeasurement bad_range;
+  bad_range.variance_m2 = 1e-2;
+  bad_range.range_m = std::nan("");
+  EXPECT_EQ(placed->update(bad_range).rejection, "non_finite_range");
+  bad_range.range_m = 1e300;
+  EXPECT_EQ(placed->update(bad_range).rejection, "implausible_range");
+  bad_range.range_m = 3.0;
+  bad_range.variance_m2 = 0.0;
+  EXPECT_EQ(placed->update(bad_range).rejection, "invalid_range");
+  bad_range.variance_m2 = 1e-2;
+  bad_range.stamp_ns = -1;
+  EXPECT_EQ(placed->update(bad_range).rejection, "invalid_stamp");
   RangeMeasurement before_map;
   before_map.range_m = 3.0;
+  before_map.variance_m2 = 1e-2;
   EXPECT_EQ(placed->update(before_map).rejection, "no_beacon_map");
   EXPECT_TRUE(placed->predict(o).accepted);
   ASSERT_TRUE(placed->estimate());

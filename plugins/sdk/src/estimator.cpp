@@ -29,7 +29,10 @@ const char* to_string(PoseStatus s) {
 bool publishable(const PoseEstimate& e) {
   return e.pose_map_base.allFinite() && e.covariance.allFinite() &&
          e.covariance.isApprox(e.covariance.transpose(), 1e-9) &&
-         (e.covariance.diagonal().array() >= 0.0).all();
+         (e.covariance.diagonal().array() >= 0.0).all() &&
+         e.pose_map_base.head<2>().cwiseAbs().maxCoeff() <= kMaxMapCoordinateM &&
+         std::abs(e.pose_map_base.z()) <= kMaxAngleRad &&
+         e.covariance.diagonal().maxCoeff() <= kMaxMapCoordinateM * kMaxMapCoordinateM;
 }
 
 std::map<std::string, double> parse_estimator_parameters(const std::vector<std::string>& items,
@@ -113,13 +116,18 @@ std::string StartupWait::describe() const {
   return note.empty() ? std::string(text) : std::string(text) + " (" + note + ")";
 }
 
-InputResult check_range(const RangeMeasurement& r, const BeaconMap& map, std::size_t receiver_count) {
+InputResult check_range_numbers(const RangeMeasurement& r) {
   if (!std::isfinite(r.range_m) || !std::isfinite(r.variance_m2))
     return InputResult::rejected("non_finite_range");
   if (!(r.range_m > 0.0) || !(r.variance_m2 > 0.0)) return InputResult::rejected("invalid_range");
   if (r.range_m > kMaxRangeM || r.variance_m2 > kMaxRangeM * kMaxRangeM)
     return InputResult::rejected("implausible_range");
   if (r.stamp_ns < 0) return InputResult::rejected("invalid_stamp");
+  return InputResult::ok();
+}
+
+InputResult check_range(const RangeMeasurement& r, const BeaconMap& map, std::size_t receiver_count) {
+  if (InputResult numbers = check_range_numbers(r); !numbers.accepted) return numbers;
   if (r.beacon_id == kBeaconUnidentified) return InputResult::rejected("unassociated_range");
   if (map.empty()) return InputResult::rejected("no_beacon_map");
   if (!map.find(r.beacon_id)) return InputResult::rejected("unknown_beacon");

@@ -16,24 +16,27 @@ bool valid_covariance(const Eigen::Matrix2d& c) {
 }
 }  // namespace
 
-OdometryTimeline::Step OdometryTimeline::advance(const OdometrySample& o) {
-  Step step;
+InputResult check_odometry_numbers(const OdometrySample& o) {
   const bool finite = std::isfinite(o.wheel_velocity_right_mps) && std::isfinite(o.wheel_velocity_left_mps) &&
                       std::isfinite(o.wheel_base_m) && o.wheel_velocity_covariance.allFinite();
-  if (!finite) {
-    step.result = InputResult::rejected("non_finite_odometry");
-  } else if (o.stamp_ns < 0) {
-    step.result = InputResult::rejected("invalid_stamp");
-  } else if (!(o.wheel_base_m > 0.0)) {
-    step.result = InputResult::rejected("invalid_wheel_base");
-  } else if (o.wheel_base_m > kMaxWheelBaseM) {
-    step.result = InputResult::rejected("implausible_wheel_base");
-  } else if (std::abs(o.wheel_velocity_right_mps) > kMaxWheelSpeedMps ||
-             std::abs(o.wheel_velocity_left_mps) > kMaxWheelSpeedMps) {
+  if (!finite) return InputResult::rejected("non_finite_odometry");
+  if (o.stamp_ns < 0) return InputResult::rejected("invalid_stamp");
+  if (!(o.wheel_base_m > 0.0)) return InputResult::rejected("invalid_wheel_base");
+  if (o.wheel_base_m > kMaxWheelBaseM) return InputResult::rejected("implausible_wheel_base");
+  if (std::abs(o.wheel_velocity_right_mps) > kMaxWheelSpeedMps ||
+      std::abs(o.wheel_velocity_left_mps) > kMaxWheelSpeedMps) {
     // Integrated, 1e300 m/s puts the pose at 1e298 m; 1000 m/s jumps it 10 m a sample.
-    step.result = InputResult::rejected("implausible_wheel_speed");
-  } else if (!valid_covariance(o.wheel_velocity_covariance)) {
-    step.result = InputResult::rejected("invalid_odometry_covariance");
+    return InputResult::rejected("implausible_wheel_speed");
+  }
+  if (!valid_covariance(o.wheel_velocity_covariance)) return InputResult::rejected("invalid_odometry_covariance");
+  return InputResult::ok();
+}
+
+OdometryTimeline::Step OdometryTimeline::advance(const OdometrySample& o) {
+  Step step;
+  step.result = check_odometry_numbers(o);
+  if (!step.result.accepted) {
+    return step;
   } else if (!last_stamp_ns_) {
     last_stamp_ns_ = o.stamp_ns;  // the anchor of the time line
   } else if (o.stamp_ns <= *last_stamp_ns_) {

@@ -60,6 +60,12 @@ InputResult OutOfSequenceFusion::predict(const OdometrySample& odometry) {
   if (!result.accepted && result.rejection != "odometry_gap") return result;
   if (newest_odometry_ns_ && odometry.stamp_ns <= *newest_odometry_ns_) return result;
   newest_odometry_ns_ = odometry.stamp_ns;
+  if (placed_before_odometry_) {
+    // The time line begins: the pose given before it is the estimator's pose from now on.
+    const Placement p = *placed_before_odometry_;
+    reset(odometry.stamp_ns, p.pose_map_base, p.covariance);
+    return result;
+  }
   if (odometry_since_checkpoint_ == 0) e.checkpoint = estimator_->clone();
   odometry_since_checkpoint_ = (odometry_since_checkpoint_ + 1) % options_.checkpoint_every;
   history_.push_back(std::move(e));
@@ -137,11 +143,14 @@ InputResult OutOfSequenceFusion::measurement(Event event) {
 }
 
 InputResult OutOfSequenceFusion::reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) {
+  if (stamp_ns < 0) return InputResult::rejected("invalid_stamp");
   const InputResult result = estimator_->reset(stamp_ns, pose_map_base, covariance);
   collect_outputs();
   if (!result.accepted) return result;
   // What came before the restart is not replayed over it.
   history_.clear();
+  placed_before_odometry_.reset();
+  if (!newest_odometry_ns_) placed_before_odometry_ = Placement{pose_map_base, covariance};
   base_ = estimator_->clone();
   // From the estimator's own time (the newest odometry), not the pose's stamp: an operator's
   // clock may run ahead of the robot's.

@@ -88,7 +88,8 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
 
   // Every good range joins the window a global fix is computed from.
   window_.push_back({r, odom_pose_});
-  while (!window_.empty() && window_.front().range.stamp_ns < r.stamp_ns - s_to_ns(params_.init_window_s)) {
+  while (!window_.empty() && (window_.front().range.stamp_ns < r.stamp_ns - s_to_ns(params_.init_window_s) ||
+                              window_.size() > kMaxWindowRanges)) {
     window_.pop_front();
   }
   if (!initialized_) {
@@ -214,7 +215,9 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
   }
   // Echoes, screened by geometry alone: two receivers d apart hearing one firing measure ranges
   // that differ by at most d (triangle inequality); an echo's path is longer, so of a pair that
-  // differs by more, the longer range is the echo.
+  // differs by more, the longer range is the echo. O(n^2) over a window of at most
+  // kMaxWindowRanges (not in strict stamp order: ranges a little ahead of the odometry are
+  // taken as they arrive).
   std::vector<bool> echo(window_.size(), false);
   for (std::size_t i = 0; i < window_.size(); ++i) {
     for (std::size_t j = i + 1; j < window_.size(); ++j) {

@@ -95,6 +95,10 @@ class RangeEkf final : public Estimator {
   OdometryTimeline timeline_;
   StampNs last_correction_stamp_ns_ = 0;
   Pose2 odom_pose_ = Pose2::Zero();  // dead-reckoned, odometry frame
+  // The newest ranges, in stamp order, within init_window_s and at most kMaxWindowRanges: 5 slots
+  // a second, up to 8 receivers, the longest window (60 s) is 2400; a bus flooding ranges (any
+  // number within the window's span) must not make each range's work grow without bound.
+  static constexpr std::size_t kMaxWindowRanges = 2400;
   std::deque<BufferedRange> window_;
   int consecutive_gated_ = 0;
   std::optional<StampNs> last_init_attempt_ns_;

@@ -99,7 +99,7 @@ std::string UkfLrf::name() const { return mode_name(mode_); }
 
 InputResult UkfLrf::update(const RangeMeasurement& r) {
   if (mode_ == Mode::kLaserOnly) return InputResult::rejected("beacons_unused");
-  if (!std::isfinite(r.range_m) || !(r.range_m > 0.0)) return InputResult::rejected("invalid_range");
+  if (InputResult numbers = check_range_numbers(r); !numbers.accepted) return numbers;
   if (r.receiver_id != 0) return InputResult::rejected("unknown_receiver");
   if (map_.empty()) return InputResult::rejected("no_beacon_map");
   if (!initialized_) return InputResult::rejected("no_initial_pose");

@@ -28,7 +28,10 @@ struct PoseEstimate {
 };
 
 // Whether an estimate may go out: finite pose, and a symmetric covariance of finite,
-// non-negative variances. Every output path (localizer, bridge, monitor, files) holds to it.
+// non-negative variances; a position within kMaxMapCoordinateM, a heading within kMaxAngleRad and
+// no variance beyond kMaxMapCoordinateM^2 (core/limits.hpp: a pose beyond any site says nothing,
+// and its squared error would overflow a metric to inf). Every output path (localizer, bridge,
+// monitor, files) holds to it.
 bool publishable(const PoseEstimate& estimate);
 
 // The answer to one pushed input: accepted, or rejected with a reason (counted in Diagnostics).
@@ -128,8 +131,12 @@ class Estimator {
   virtual std::unique_ptr<Estimator> clone() const = 0;
 };
 
-// The checks every range-based estimator makes of a range: finite, positive, from an identified
-// beacon of the map, to a receiver the robot has. Accepted, or the typed rejection.
+// The checks of a range's numbers, whichever estimator takes it: finite (non_finite_range),
+// positive (invalid_range), within kMaxRangeM (implausible_range), a stamp >= 0 (invalid_stamp).
+InputResult check_range_numbers(const RangeMeasurement& range);
+
+// The checks every estimator of identified ranges makes of a range: its numbers, then from an
+// identified beacon of the map, to a receiver the robot has. Accepted, or the typed rejection.
 InputResult check_range(const RangeMeasurement& range, const BeaconMap& map, std::size_t receiver_count);
 
 // The checks of a pose to reset an estimator from: finite, and a symmetric positive-definite

@@ -9,6 +9,14 @@
 
 namespace beaconloc {
 
+// The checks of an odometry sample's numbers, wherever one is taken (the estimators' time line,
+// the bridge's odom frame, a driver's odometry turned into wheel speeds): finite
+// (non_finite_odometry), a stamp >= 0 (invalid_stamp), a wheel base in (0, kMaxWheelBaseM]
+// (invalid_wheel_base, implausible_wheel_base), wheel speeds within kMaxWheelSpeedMps
+// (implausible_wheel_speed), a symmetric positive semi-definite covariance with no variance beyond
+// kMaxWheelSpeedMps^2 (invalid_odometry_covariance).
+InputResult check_odometry_numbers(const OdometrySample& o);
+
 class OdometryTimeline {
  public:
   explicit OdometryTimeline(double max_gap_s) : max_gap_s_(max_gap_s) {}

@@ -46,7 +46,12 @@ class OutOfSequenceFusion {
   InputResult predict(const OdometrySample& odometry);
   InputResult update(const RangeMeasurement& range);
   InputResult update_laser(const LaserScanSample& scan);
-  // A restart from a given pose forgets the history: nothing before it is replayed.
+  // A restart from a given pose forgets the history: nothing before it is replayed. It takes
+  // effect at the estimator's own time (its newest odometry), never at the pose's stamp, which
+  // comes from another clock (an operator's, rviz2's): before the first odometry sample the pose
+  // is placed again when that sample starts the time line, so that a stamp far ahead cannot keep
+  // the pose "ok" for as long as the robot's clock takes to reach it. A negative stamp is
+  // refused (invalid_stamp).
   InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance);
 
   const Estimator& estimator() const { return *estimator_; }
@@ -79,6 +84,11 @@ class OutOfSequenceFusion {
   StampNs base_stamp_ns_;
   std::deque<Event> history_;  // processing order
   std::optional<StampNs> newest_odometry_ns_;
+  struct Placement {
+    Pose2 pose_map_base;
+    Cov3 covariance;
+  };
+  std::optional<Placement> placed_before_odometry_;  // reset() before the time line began
   int odometry_since_checkpoint_ = 0;
   std::vector<Estimator::Association> associations_;
   std::vector<std::string> deferred_rejections_;

@@ -9,6 +9,12 @@
 // the sample. Each refusal is counted (Diagnostics: undecodable_sample); Fast DDS reads a sample
 // of a keyed topic twice when its writer sent no key hash (for its key, then when it is taken),
 // so such a sample counts twice.
+//
+// A payload that reads but carries an enumeration value the type does not define (Fast CDR reads
+// an enum as a 32-bit integer and casts it unchecked: a Diagnostics status of 7 printed as "ok",
+// one of 0xFFFFFFFF indexed a table at -1) is refused the same way: no reader ever sees a value
+// its switch does not list. defines_every_enum() holds one overload per type with an enum field.
+#include <beaconloc.h>
 #include <fastcdr/exceptions/Exception.h>
 #include <fastdds/rtps/common/SerializedPayload.h>
 
@@ -16,6 +22,15 @@
 #include <cstdint>
 
 namespace beaconloc::dds {
+
+// True when every enumeration field of `m` holds a value its IDL type defines.
+bool defines_every_enum(const msg::BeaconRange& m);
+bool defines_every_enum(const msg::PoseEstimate& m);
+bool defines_every_enum(const msg::Diagnostics& m);
+template <class Msg>
+bool defines_every_enum(const Msg&) {
+  return true;  // no enumeration field
+}
 
 template <class PubSubType>
 class CheckedType : public PubSubType {
@@ -25,7 +40,10 @@ class CheckedType : public PubSubType {
 
   bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override {
     try {
-      if (PubSubType::deserialize(payload, data)) return true;
+      if (PubSubType::deserialize(payload, data) &&
+          defines_every_enum(*static_cast<const typename PubSubType::type*>(data))) {
+        return true;
+      }
     } catch (const eprosima::fastcdr::exception::Exception&) {
     }
     if (refused_) ++*refused_;

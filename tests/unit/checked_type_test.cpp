@@ -1,0 +1,74 @@
+// Every enumeration on the bus is checked at the reader's door (dds::CheckedType): Fast CDR reads
+// an enum as a 32-bit integer and casts it unchecked, so a hostile or corrupted sample could carry
+// a status no switch lists (the monitor once indexed its status names at -1). No participant: no
+// DDS traffic.
+#include <beaconlocPubSubTypes.h>
+#include <fastdds/rtps/common/SerializedPayload.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdint>
+
+#include "beaconloc/dds/checked_type.hpp"
+
+namespace beaconloc::dds {
+namespace {
+
+// Sends `m` through the type support and reads it back: whether the reader took it, and the
+// refusals counted.
+template <class PubSubType>
+std::pair<bool, std::uint64_t> round_trip(const typename PubSubType::type& m) {
+  std::atomic<std::uint64_t> refused{0};
+  CheckedType<PubSubType> type(&refused);
+  eprosima::fastrtps::rtps::SerializedPayload_t wire(type.m_typeSize + 4096);
+  auto sent = m;
+  EXPECT_TRUE(type.serialize(&sent, &wire));
+  typename PubSubType::type received;
+  const bool taken = type.deserialize(&wire, &received);
+  return {taken, refused.load()};
+}
+
+constexpr std::uint32_t kUndefined[] = {3, 7, 0x7FFFFFFF, 0xFFFFFFFF};
+
+TEST(CheckedType, ADiagnosticsStatusTheIdlDoesNotDefineIsRefusedAndCounted) {
+  msg::Diagnostics d;
+  d.participant("p");
+  for (auto s : {msg::PARTICIPANT_STATUS_OK, msg::PARTICIPANT_STATUS_DEGRADED, msg::PARTICIPANT_STATUS_ERROR}) {
+    d.status(s);
+    EXPECT_EQ(round_trip<msg::DiagnosticsPubSubType>(d), std::make_pair(true, std::uint64_t{0}));
+  }
+  for (std::uint32_t v : kUndefined) {
+    d.status(static_cast<msg::ParticipantStatus>(v));
+    EXPECT_EQ(round_trip<msg::DiagnosticsPubSubType>(d), std::make_pair(false, std::uint64_t{1})) << v;
+  }
+}
+
+TEST(CheckedType, APoseStatusTheIdlDoesNotDefineIsRefusedAndCounted) {
+  msg::PoseEstimate p;
+  p.robot_id("r");
+  for (auto s : {msg::POSE_STATUS_INITIALIZING, msg::POSE_STATUS_OK, msg::POSE_STATUS_DEGRADED,
+                 msg::POSE_STATUS_LOST}) {
+    p.status(s);
+    EXPECT_EQ(round_trip<msg::PoseEstimatePubSubType>(p), std::make_pair(true, std::uint64_t{0}));
+  }
+  for (std::uint32_t v : {std::uint32_t{4}, kUndefined[1], kUndefined[3]}) {
+    p.status(static_cast<msg::PoseStatus>(v));
+    EXPECT_EQ(round_trip<msg::PoseEstimatePubSubType>(p), std::make_pair(false, std::uint64_t{1})) << v;
+  }
+}
+
+TEST(CheckedType, ARangeAssociationTheIdlDoesNotDefineIsRefusedNotReadAsIdentified) {
+  msg::BeaconRange r;
+  r.robot_id("r");
+  for (auto a : {msg::RANGE_ASSOCIATION_BY_ID, msg::RANGE_ASSOCIATION_UNASSOCIATED}) {
+    r.association(a);
+    EXPECT_EQ(round_trip<msg::BeaconRangePubSubType>(r), std::make_pair(true, std::uint64_t{0}));
+  }
+  for (std::uint32_t v : {std::uint32_t{2}, kUndefined[1], kUndefined[3]}) {
+    r.association(static_cast<msg::RangeAssociation>(v));
+    EXPECT_EQ(round_trip<msg::BeaconRangePubSubType>(r), std::make_pair(false, std::uint64_t{1})) << v;
+  }
+}
+
+}  // namespace
+}  // namespace beaconloc::dds
