@@ -46,6 +46,7 @@ class LocalizerCore {
   // what an estimator holds was measured against the old beacons (restart_robot).
   void set_beacon_map(const BeaconMap& map);
   bool has_beacon_map() const { return !map_.empty(); }
+  const BeaconMap& beacon_map() const { return map_; }
   std::uint64_t beacon_map_changes() const { return beacon_map_changes_; }
   // Predicts; returns the pose to publish once the robot's estimator has one.
   std::optional<LocalizerOutput> on_odometry(const std::string& robot_id, const OdometrySample& odometry);

@@ -23,10 +23,21 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       conflicts_(std::chrono::duration_cast<std::chrono::nanoseconds>(dds::kDiagnosticsSilentAfter).count()),
       participant_(dds, "beaconloc.localizer." + core_.estimator_name()),
       pose_writer_(participant_.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic)) {
-  participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [this](const msg::BeaconMap& m) {
+  // Every writer's map is remembered: two live gateways with different maps are reported.
+  dds::ReaderEvents<msg::BeaconMap> map_events;
+  map_events.on_writer_gone = [this](const std::string& writer) {
     std::lock_guard<std::mutex> lock(mutex_);
-    core_.on_beacon_map(dds::from_msg(m));
-  });
+    map_sources_.on_writer_gone(writer);
+  };
+  participant_.subscribe_with_info<msg::BeaconMapPubSubType>(
+      dds::kBeaconMapTopic,
+      [this](const msg::BeaconMap& m, const eprosima::fastdds::dds::SampleInfo& info) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (core_.on_beacon_map(dds::from_msg(m))) {
+          map_sources_.on_map(dds::writer_id(info.publication_handle), core_.beacon_map());
+        }
+      },
+      map_events);
   // A robot whose ranges miss their deadline (two beacon slots) coasts on odometry, degraded.
   dds::ReaderEvents<msg::BeaconRange> range_events;
   range_events.deadline_misses = &deadline_misses_;
@@ -187,6 +198,11 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   if (core_.beacon_map_changes()) {
     message += "; beacon map replaced " + std::to_string(core_.beacon_map_changes()) +
                " time(s), every robot restarted on it";
+  }
+  if (map_sources_.distinct_maps() > 1) {
+    // Whichever map arrived last is in use; the robots flip between layouts as the maps arrive.
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message = "beacon maps disagree: " + map_sources_.describe() + ", the newest is in use; " + message;
   }
   if (conflicts_.contested_robots()) {
     // Its poses of those robots go out degraded; the other localizer reports the same.

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <string>
 
+#include "beaconloc/core/beacon_map_sources.hpp"
 #include "beaconloc/dds/diagnostics_publisher.hpp"
 #include "beaconloc/dds/participant.hpp"
 #include "localizer_core.hpp"
@@ -44,6 +45,7 @@ class LocalizerParticipant {
   std::mutex mutex_;
   LocalizerCore core_;
   ServingConflicts conflicts_;
+  BeaconMapSources map_sources_;  // the live map writers' maps
   std::string own_diagnostics_writer_;      // its own reports come back to its reader: not a peer
   std::uint64_t peer_reports_refused_ = 0;  // listing more than DIAGNOSTICS_MAX_ROBOTS robots
   std::size_t robots_told_ = 0;             // robots the conflicts know it serves (robots are never removed)

@@ -1,7 +1,8 @@
-// Every enumeration on the bus is checked at the reader's door (dds::CheckedType): Fast CDR reads
-// an enum as a 32-bit integer and casts it unchecked, so a hostile or corrupted sample could carry
-// a status no switch lists (the monitor once indexed its status names at -1). No participant: no
-// DDS traffic.
+// Every enumeration and string on the bus is checked at the reader's door (dds::CheckedType): Fast
+// CDR reads an enum as a 32-bit integer and casts it unchecked, so a hostile or corrupted sample
+// could carry a status no switch lists (the monitor once indexed its status names at -1), and a
+// string with a newline or an escape sequence would forge the monitor's lines and the CSV rows.
+// No participant: no DDS traffic.
 #include <beaconlocPubSubTypes.h>
 #include <fastdds/rtps/common/SerializedPayload.h>
 #include <gtest/gtest.h>
@@ -68,6 +69,35 @@ TEST(CheckedType, ARangeAssociationTheIdlDoesNotDefineIsRefusedNotReadAsIdentifi
     r.association(static_cast<msg::RangeAssociation>(v));
     EXPECT_EQ(round_trip<msg::BeaconRangePubSubType>(r), std::make_pair(false, std::uint64_t{1})) << v;
   }
+}
+
+TEST(CheckedType, AStringWithAControlCharacterIsRefusedOnEveryTopic) {
+  const std::string forged[] = {"robot1\nmonitor: 0 poses", "\x1b[2Jr", "r\x7f", "r\tb"};
+  for (const std::string& bad : forged) {
+    msg::Diagnostics d;
+    d.participant("p");
+    d.message(bad);
+    EXPECT_EQ(round_trip<msg::DiagnosticsPubSubType>(d), std::make_pair(false, std::uint64_t{1}));
+    d.message("fine");
+    d.robots_localized({"a", bad});
+    EXPECT_EQ(round_trip<msg::DiagnosticsPubSubType>(d), std::make_pair(false, std::uint64_t{1}));
+    msg::PoseEstimate p;
+    p.robot_id(bad);
+    EXPECT_EQ(round_trip<msg::PoseEstimatePubSubType>(p), std::make_pair(false, std::uint64_t{1}));
+    msg::Odometry o;
+    o.robot_id(bad);
+    EXPECT_EQ(round_trip<msg::OdometryPubSubType>(o), std::make_pair(false, std::uint64_t{1}));
+    msg::RawTof t;
+    t.robot_id(bad);
+    EXPECT_EQ(round_trip<msg::RawTofPubSubType>(t), std::make_pair(false, std::uint64_t{1}));
+    msg::BeaconMap m;
+    m.frame_id(bad);
+    EXPECT_EQ(round_trip<msg::BeaconMapPubSubType>(m), std::make_pair(false, std::uint64_t{1}));
+  }
+  // UTF-8 and punctuation are names like any other.
+  msg::PoseEstimate p;
+  p.robot_id("röbot-7/base_link");
+  EXPECT_EQ(round_trip<msg::PoseEstimatePubSubType>(p), std::make_pair(true, std::uint64_t{0}));
 }
 
 }  // namespace

@@ -10,10 +10,13 @@
 // of a keyed topic twice when its writer sent no key hash (for its key, then when it is taken),
 // so such a sample counts twice.
 //
-// A payload that reads but carries an enumeration value the type does not define (Fast CDR reads
-// an enum as a 32-bit integer and casts it unchecked: a Diagnostics status of 7 printed as "ok",
-// one of 0xFFFFFFFF indexed a table at -1) is refused the same way: no reader ever sees a value
-// its switch does not list. defines_every_enum() holds one overload per type with an enum field.
+// A payload that reads but is not well formed is refused the same way: an enumeration value the
+// type does not define (Fast CDR reads an enum as a 32-bit integer and casts it unchecked: a
+// Diagnostics status of 7 printed as "ok", one of 0xFFFFFFFF indexed a table at -1), or a string
+// with a control character (a robot id or a Diagnostics message carrying a newline or a terminal
+// escape sequence would forge lines in the monitor's output and rows in the CSV files). No reader
+// ever sees a value its switch does not list or a string it cannot print. well_formed() holds one
+// overload per beaconloc type; other types (the ROS 2 ones) are taken as they read.
 #include <beaconloc.h>
 #include <fastcdr/exceptions/Exception.h>
 #include <fastdds/rtps/common/SerializedPayload.h>
@@ -23,13 +26,19 @@
 
 namespace beaconloc::dds {
 
-// True when every enumeration field of `m` holds a value its IDL type defines.
-bool defines_every_enum(const msg::BeaconRange& m);
-bool defines_every_enum(const msg::PoseEstimate& m);
-bool defines_every_enum(const msg::Diagnostics& m);
+// True when every enumeration field of `m` holds a value its IDL type defines and no string field
+// holds an ASCII control character.
+bool well_formed(const msg::RawTof& m);
+bool well_formed(const msg::BeaconRange& m);
+bool well_formed(const msg::Odometry& m);
+bool well_formed(const msg::LaserScan& m);
+bool well_formed(const msg::PoseEstimate& m);
+bool well_formed(const msg::InitialPose& m);
+bool well_formed(const msg::BeaconMap& m);
+bool well_formed(const msg::Diagnostics& m);
 template <class Msg>
-bool defines_every_enum(const Msg&) {
-  return true;  // no enumeration field
+bool well_formed(const Msg&) {
+  return true;  // a type of another system's (ROS 2): read as it is
 }
 
 template <class PubSubType>
@@ -41,7 +50,7 @@ class CheckedType : public PubSubType {
   bool deserialize(eprosima::fastrtps::rtps::SerializedPayload_t* payload, void* data) override {
     try {
       if (PubSubType::deserialize(payload, data) &&
-          defines_every_enum(*static_cast<const typename PubSubType::type*>(data))) {
+          well_formed(*static_cast<const typename PubSubType::type*>(data))) {
         return true;
       }
     } catch (const eprosima::fastcdr::exception::Exception&) {

@@ -1,0 +1,31 @@
+#pragma once
+// Who publishes the beacon map, and whether they agree. The map topic keeps each writer's newest
+// map; a participant takes whichever arrives last. Two live gateways with different maps (a
+// misconfigured site, a gateway started with the wrong scenario) would flip a robot between two
+// beacon layouts silently: they are a conflict to report instead (Diagnostics degraded, naming
+// it), until all but one writer are gone or they publish the same map. Keyed by writer id;
+// bounded by the writers the bus matches. DDS-free.
+#include <cstddef>
+#include <map>
+#include <string>
+
+#include "beaconloc/core/beacon_map.hpp"
+
+namespace beaconloc {
+
+class BeaconMapSources {
+ public:
+  // A map taken from `writer` (a refused one is not a source).
+  void on_map(const std::string& writer, const BeaconMap& map);
+  // The writer left the bus (unmatched, or its liveliness lapsed).
+  void on_writer_gone(const std::string& writer);
+  // How many different maps the live writers publish (0 before any map, 1 when they agree).
+  std::size_t distinct_maps() const;
+  // "N writers publish M different beacon maps", for a Diagnostics message.
+  std::string describe() const;
+
+ private:
+  std::map<std::string, BeaconMap> by_writer_;
+};
+
+}  // namespace beaconloc
