@@ -69,7 +69,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
                                                           const OdometrySample& odometry) {
   Robot* r = robot(robot_id, "odometry");
   if (!r) return std::nullopt;
-  r->odometry_silent = false;  // the bus delivers odometry again
+  r->odometry_deadlines_missed = 0;  // the bus delivers odometry again
   InputResult result = r->fusion.predict(odometry);
   for (const auto& reason : r->fusion.take_deferred_rejections()) counts_.reject("deferred." + reason);
   if (!result.accepted && result.rejection == "out_of_order_odometry" && clock_jumped_back(*r, odometry)) {
@@ -187,15 +187,15 @@ void LocalizerCore::on_ranges_silent(const std::string& robot_id) {
   if (it != robots_.end()) it->second.ranges_silent = true;
 }
 
-void LocalizerCore::on_odometry_silent(const std::string& robot_id) {
+void LocalizerCore::on_odometry_deadline_missed(const std::string& robot_id) {
   auto it = robots_.find(robot_id);
-  if (it != robots_.end()) it->second.odometry_silent = true;
+  if (it != robots_.end() && !it->second.odometry_silent()) ++it->second.odometry_deadlines_missed;
 }
 
 std::vector<std::string> LocalizerCore::odometry_silent_robots() const {
   std::vector<std::string> ids;
   for (const auto& [id, r] : robots_) {
-    if (r.odometry_silent) ids.push_back(id);
+    if (r.odometry_silent()) ids.push_back(id);
   }
   return ids;
 }
@@ -234,7 +234,7 @@ PoseStatus LocalizerCore::Robot::status() const {
   // Silent ranges make a good pose degraded at once, rather than after the estimator's own
   // 1 s of data time without a fused range.
   // Silent odometry: the pose stands still while the robot may move.
-  if ((ranges_silent || odometry_silent) && severity(estimator_status) < severity(PoseStatus::kDegraded))
+  if ((ranges_silent || odometry_silent()) && severity(estimator_status) < severity(PoseStatus::kDegraded))
     return PoseStatus::kDegraded;
   return estimator_status;
 }

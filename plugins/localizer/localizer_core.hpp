@@ -67,10 +67,13 @@ class LocalizerCore {
   // The bus says the robot's ranges stopped (the beacon_range reader's deadline, two slots, was
   // missed): its poses are published degraded, coasting on odometry, until a range arrives.
   void on_ranges_silent(const std::string& robot_id);
-  // The bus says the robot's odometry stopped (the odometry reader's deadline, five periods, was
-  // missed: a gateway that stopped, hung or lost its link): its pose cannot follow the robot, so
-  // it is degraded until odometry arrives again. The robots in that state, for the Diagnostics.
-  void on_odometry_silent(const std::string& robot_id);
+  // The odometry reader's deadline (five periods, 50 ms) passed without a sample of the robot. After
+  // kOdometrySilentAfterMisses in a row the robot's odometry is silent (a gateway that stopped, hung
+  // or lost its link): its pose cannot follow the robot, so it is degraded until odometry arrives
+  // again. One or two misses are a stall of a busy machine, not a dead input. The robots whose
+  // odometry is silent, for the Diagnostics.
+  static constexpr int kOdometrySilentAfterMisses = 4;
+  void on_odometry_deadline_missed(const std::string& robot_id);
   std::vector<std::string> odometry_silent_robots() const;
   // Late measurements fused at their own stamp, over every robot (core/out_of_sequence_fusion).
   std::uint64_t replays() const;
@@ -94,7 +97,8 @@ class LocalizerCore {
     OutOfSequenceFusion fusion;
     std::set<std::uint32_t> beacons_used;
     bool ranges_silent = false;
-    bool odometry_silent = false;
+    int odometry_deadlines_missed = 0;  // in a row, since the robot's last odometry sample
+    bool odometry_silent() const { return odometry_deadlines_missed >= kOdometrySilentAfterMisses; }
     std::optional<StampNs> jump_candidate_ns;  // an odometry stamp far behind the time line
     PoseStatus status() const;
   };

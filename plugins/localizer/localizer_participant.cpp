@@ -67,11 +67,11 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
   odometry_events.writers_lost = &odometry_writers_lost_;
   odometry_events.lost_and_none_alive = &odometry_writer_lost_;
   // A gateway that stopped or hung (its liveliness is asserted by a task of its own, so a hung run
-  // loop still looks alive) shows as a missed deadline: the robot is degraded until odometry
-  // flows again.
+  // loop still looks alive) shows as missed deadlines: past a few in a row the robot is degraded
+  // until odometry flows again (LocalizerCore::kOdometrySilentAfterMisses).
   odometry_events.on_deadline_missed = [this](const msg::Odometry& key) {
     std::lock_guard<std::mutex> lock(mutex_);
-    core_.on_odometry_silent(key.robot_id());
+    core_.on_odometry_deadline_missed(key.robot_id());
   };
   participant_.subscribe<msg::OdometryPubSubType>(
       dds::kOdometryTopic, [this](const msg::Odometry& m) { on_odometry(m); }, odometry_events);

@@ -149,6 +149,26 @@ TEST(LocalizerCore, SilentRangesDegradeThePoseUntilARangeArrives) {
   EXPECT_EQ(robot.last->estimate.status, PoseStatus::kOk);
 }
 
+// Odometry that stops (its reader's deadline missed kOdometrySilentAfterMisses times in a row: a
+// gateway stopped or hung) degrades the robot and names it; a stall of a missed deadline or two
+// does not; the next odometry sample clears it.
+TEST(LocalizerCore, SilentOdometryDegradesTheRobotUntilOdometryArrives) {
+  LocalizedRobot robot;
+  robot.feed(0.0, 5.0);
+  ASSERT_TRUE(robot.last);
+  EXPECT_EQ(robot.core.worst_status(), PoseStatus::kOk);
+  for (int i = 1; i < LocalizerCore::kOdometrySilentAfterMisses; ++i) robot.core.on_odometry_deadline_missed("r");
+  EXPECT_EQ(robot.core.worst_status(), PoseStatus::kOk);  // a stall, not a dead input
+  EXPECT_TRUE(robot.core.odometry_silent_robots().empty());
+  robot.core.on_odometry_deadline_missed("r");
+  EXPECT_EQ(robot.core.worst_status(), PoseStatus::kDegraded);
+  EXPECT_EQ(robot.core.odometry_silent_robots(), std::vector<std::string>{"r"});
+  robot.core.on_odometry_deadline_missed("nobody");  // a robot it never heard: nothing to mark
+  robot.feed(5.0, 5.5);
+  EXPECT_EQ(robot.core.worst_status(), PoseStatus::kOk);
+  EXPECT_TRUE(robot.core.odometry_silent_robots().empty());
+}
+
 // The robot's clock steps back 30 s (a gateway restarted on a replayed clock): one sample is
 // refused as out of order, the next confirms the jump, and the robot's estimator starts over
 // from a global fix on the new time line instead of refusing every sample from then on.
