@@ -30,8 +30,8 @@ TEST_F(GatewayStop, ASlowGatewayStopsAtOnceOnASignal) {
       // A robot id of its own per run: the Diagnostics seen are this process's, not the last one's.
       const std::string robot = "slow" + std::to_string(++run);
       ChildProcess gateway(command("gateway", {"--speed", speed, "--robot", robot}), path(robot + ".log"));
-      // Waiting: it counts what it wrote, the beacon map and the first step's samples (stamp 0, due
-      // at once); the next step is due only 5-10 s after its start, so it is in that wait now.
+      // Waiting: it counts what it wrote, and it writes the beacon map at once; its first samples
+      // (10 ms of data) are due only 5-10 s after its start, so it is in that wait now.
       const auto waiting = wait_for_diagnostics(diagnostics, "beaconloc.gateway." + robot,
                                                 [](const msg::Diagnostics& d) { return d.accepted() > 0; });
       ASSERT_GT(waiting.accepted(), 0u) << "the gateway never published\n" << gateway.log();
