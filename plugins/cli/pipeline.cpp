@@ -129,6 +129,25 @@ void wait_until_reporting(const DiagnosticsRecorder& diagnostics,
   }
 }
 
+// Waits until this process has heard each participant named leave the bus (its dispose when it
+// stopped, or the end of its writer), at most kLeaveTimeout: a process that exited has sent its
+// dispose, but this reader may not have taken it yet, and its report would still show it alive.
+void wait_until_left(const DiagnosticsRecorder& diagnostics, const std::vector<std::string>& names) {
+  constexpr auto kLeaveTimeout = 3s;
+  const auto give_up = std::chrono::steady_clock::now() + kLeaveTimeout;
+  auto left = [&] {
+    const auto reports = diagnostics.reports();
+    for (const auto& name : names) {
+      const auto it = reports.find(name);
+      if (it != reports.end() &&
+          (it->second.liveness == Liveness::kAlive || it->second.liveness == Liveness::kSilent))
+        return false;
+    }
+    return true;
+  };
+  while (!left() && std::chrono::steady_clock::now() < give_up) std::this_thread::sleep_for(20ms);
+}
+
 // Waits until the pipeline has drained after the gateway ended: no new pose for kQuiet (a
 // localizer still working through what it holds publishes at the odometry rate), at most
 // kMaxDrain.
@@ -405,6 +424,8 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
                              ", decoder " + std::to_string(decoder_code) + ", localizer " +
                              std::to_string(localizer_code) + "); logs in " + o.out_dir);
   }
+  wait_until_left(diagnostics, {"beaconloc.gateway." + o.gateway.robot_id, "beaconloc.decoder",
+                                "beaconloc.localizer." + o.localizer.estimator});
   std::ostringstream diag;
   print_diagnostics(diagnostics.reports(), diag);
   return finish(o, source, beacons, recorder.poses(), load_truth_csv(o.out_dir + "/truth.csv"), diag.str());

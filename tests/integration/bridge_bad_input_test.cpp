@@ -4,11 +4,11 @@
 #include <beaconlocPubSubTypes.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <mutex>
-#include <thread>
 
 #include "beaconloc/dds/convert.hpp"
 #include "diagnostics_recorder.hpp"
@@ -109,14 +109,21 @@ TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
   EXPECT_EQ(rejected_count(refused, "beacon_map.non_finite_position"), 1u) << refused.message();
   map_writer->write(&map);
 
+  // Everything is through once the last sample of each kind is: the bridge handles a topic's
+  // samples in order and writes what it passes on in that order, so a bad sample that got through
+  // would have arrived before the good one written after it (the map: before the good map's
+  // markers, as the bad map was refused before the good one was written).
   ASSERT_TRUE(eventually(
       [&] {
         std::lock_guard<std::mutex> lock(mutex);
-        return poses.size() >= 2 && ranges.size() >= 2 && marker_arrays >= 1;
+        const bool last_pose = std::any_of(poses.begin(), poses.end(),
+                                           [](const auto& p) { return p.header().stamp().sec() == 4; });
+        const bool last_range =
+            std::any_of(ranges.begin(), ranges.end(), [](const auto& r) { return r.range() == 2.5f; });
+        return last_pose && last_range && marker_arrays >= 1;
       },
       10s))
       << bridge.log();
-  std::this_thread::sleep_for(scaled(500ms));  // anything else that was to come
   {
     std::lock_guard<std::mutex> lock(mutex);
     EXPECT_EQ(poses.size(), 2u);
@@ -128,9 +135,13 @@ TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
     for (const auto& r : ranges) EXPECT_TRUE(std::isfinite(r.range()));
     EXPECT_EQ(marker_arrays, 1u);
   }
-  const auto latest = wait_for_diagnostics(
-      diagnostics, "beaconloc.bridge.robot1",
-      [](const msg::Diagnostics& d) { return rejected_count(d, "beacon_map.non_finite_position") > 0; });
+  // A report that has counted every refusal: a report taken before the bad pose or the bad range
+  // was counted would show fewer.
+  const auto latest =
+      wait_for_diagnostics(diagnostics, "beaconloc.bridge.robot1", [](const msg::Diagnostics& d) {
+        return rejected_count(d, "pose.unusable") >= 2 && rejected_count(d, "range.unusable") >= 1 &&
+               rejected_count(d, "beacon_map.non_finite_position") >= 1;
+      });
   EXPECT_EQ(rejected_count(latest, "pose.unusable"), 2u);
   EXPECT_EQ(rejected_count(latest, "range.unusable"), 1u);
   EXPECT_EQ(rejected_count(latest, "beacon_map.non_finite_position"), 1u);

@@ -203,10 +203,12 @@ TEST(Cli, AccuracyPrintsATableOverSeeds) {
   EXPECT_NE(bad_out.find("nope"), std::string::npos) << bad_out;
 }
 
+// In real time, the demo's own pace: the demo's gateway is paced by the wall clock and never
+// waits for the localizer (only `run` at its default speed does), so faster than real time on a
+// busy machine it outran the localizer's odometry history and the accuracy measured the load.
 TEST(Cli, DemoEndsWithThePositionRmsAgainstGroundTruth) {
   DomainLease domain;
-  auto [code, out] =
-      beaconloc({"demo", "--domain", std::to_string(domain.id()), "--duration-s", "12", "--speed", "4"});
+  auto [code, out] = beaconloc({"demo", "--domain", std::to_string(domain.id()), "--duration-s", "12"});
   EXPECT_EQ(code, 0) << out;
   const auto at = out.rfind("position RMS ");
   ASSERT_NE(at, std::string::npos) << out;

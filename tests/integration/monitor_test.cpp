@@ -149,7 +149,8 @@ TEST_F(Monitor, TwoLocalizersServingOneRobotBothReportTheConflictUntilOneStops) 
   ChildProcess ekf_localizer(command("localizer", {"--estimator", "range_ekf"}), path("range_ekf.log"));
   ChildProcess duhl_localizer(command("localizer", {"--estimator", "duhl"}), path("duhl.log"));
   ChildProcess decoder(command("decoder"), path("decoder.log"));
-  ChildProcess gateway(command("gateway", {"--robot", "robot1", "--duration-s", "120", "--seed", "3"}),
+  // Until stopped (--duration-s 0): it runs through every wait below, however long they take.
+  ChildProcess gateway(command("gateway", {"--robot", "robot1", "--duration-s", "0", "--seed", "3"}),
                        path("gateway.log"));
 
   auto in_conflict = [](const std::map<std::string, msg::Diagnostics>& latest, const std::string& name,

@@ -5,9 +5,9 @@
 #include <stdlib.h>
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <map>
-#include <thread>
 
 #include "diagnostics_recorder.hpp"
 #include "domain_id.hpp"
@@ -22,6 +22,9 @@ using namespace std::chrono_literals;
 
 class Pipeline : public ParticipantsTest {};
 
+// What a gateway has written after 3 s of its run: 100 odometry samples and 15 TOFs a second.
+constexpr std::uint64_t kBetaAhead = 3 * (100 + 15);
+
 TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   PoseRecorder recorder(dds_);
   DiagnosticsRecorder diagnostics(dds_);
@@ -30,10 +33,13 @@ TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   // Their readers exist before the gateway writes, however slowly they started.
   ASSERT_TRUE(wait_until_reporting(diagnostics, {kDecoder, kRangeEkfLocalizer}))
       << decoder.log() << localizer.log();
-  ChildProcess gateway(command("gateway", {"--robot", "robot7", "--duration-s", "25", "--seed", "5",
+  // Runs until the robot has been localized over 20 s of its time, however long discovery took.
+  ChildProcess gateway(command("gateway", {"--robot", "robot7", "--duration-s", "0", "--seed", "5",
                                            "--truth-out", path("truth.csv")}),
                        path("gateway.log"));
-  ASSERT_NO_FATAL_FAILURE(finish_gateway(gateway, recorder, "robot7", path("truth.csv")));
+  ASSERT_TRUE(wait_for_pose_span(recorder, "robot7", 20s))
+      << localizer.log() << decoder.log() << gateway.log();
+  ASSERT_NO_FATAL_FAILURE(stop_gateway(gateway, recorder, "robot7", path("truth.csv")));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
 
@@ -48,10 +54,10 @@ TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
   std::printf(
       "multi-process pipeline: first pose %.2f s into the run; %zu poses over %.1f s of motion at %.1f Hz; "
       "position RMS %.3f m, max %.3f m; heading RMS %.2f deg\n",
-      first_pose_s, s.poses, stamp_span_s, s.pose_rate_hz, s.metrics.position_rms_m, s.metrics.position_max_m,
-      s.metrics.heading_rms_deg.value_or(-1));
-  EXPECT_GE(stamp_span_s, 20.0);  // localized over >= 20 s of motion
-  EXPECT_GE(s.pose_rate_hz, 90.0);
+      first_pose_s, s.poses, stamp_span_s, stamp_rate_hz(poses), s.metrics.position_rms_m,
+      s.metrics.position_max_m, s.metrics.heading_rms_deg.value_or(-1));
+  EXPECT_GE(stamp_span_s, 20.0);          // localized over >= 20 s of motion
+  EXPECT_GE(stamp_rate_hz(poses), 90.0);  // a pose for (nearly) every odometry sample
   EXPECT_EQ(s.metrics.samples_without_truth, 0u);
   EXPECT_LE(s.metrics.position_rms_m, 0.15);
 
@@ -69,11 +75,11 @@ TEST_F(Pipeline, ThreeProcessesLocalizeAtOdometryRate) {
 
 TEST_F(Pipeline, LateJoiningLocalizerGetsTheMapAndLocalizes) {
   DiagnosticsRecorder diagnostics(dds_);
-  ChildProcess gateway(command("gateway", {"--robot", "late", "--duration-s", "20", "--seed", "6",
+  ChildProcess gateway(command("gateway", {"--robot", "late", "--duration-s", "0", "--seed", "6",
                                            "--truth-out", path("truth.csv")}),
                        path("gateway.log"));
   ChildProcess decoder(command("decoder"), path("decoder.log"));
-  // The localizer joins ~5 s into the run, long after the gateway wrote the beacon map, once:
+  // The localizer joins >= 4 s into the run, long after the gateway wrote the beacon map, once:
   // when the decoder (which needs that map) has decoded 4 s of TOFs (15 a second), counted from
   // the run's progress, not from when this test started the gateway.
   const auto decoding = wait_for_diagnostics(diagnostics, kDecoder,
@@ -81,7 +87,9 @@ TEST_F(Pipeline, LateJoiningLocalizerGetsTheMapAndLocalizes) {
   ASSERT_GE(decoding.accepted(), 60u) << decoder.log() << gateway.log();
   PoseRecorder recorder(dds_);
   ChildProcess localizer(command("localizer"), path("localizer.log"));
-  ASSERT_NO_FATAL_FAILURE(finish_gateway(gateway, recorder, "late", path("truth.csv")));
+  // The run goes on until the late localizer has localized over 12 s, however long it took to start.
+  ASSERT_TRUE(wait_for_pose_span(recorder, "late", 12s)) << localizer.log() << decoder.log() << gateway.log();
+  ASSERT_NO_FATAL_FAILURE(stop_gateway(gateway, recorder, "late", path("truth.csv")));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(decoder, "decoder"));
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
 
@@ -92,11 +100,10 @@ TEST_F(Pipeline, LateJoiningLocalizerGetsTheMapAndLocalizes) {
   const double stamp_span_s =
       ns_to_s(poses.back().row.estimate.stamp_ns - poses.front().row.estimate.stamp_ns);
   std::printf("late-joining localizer: %zu poses over %.1f s at %.1f Hz; position RMS %.3f m\n", s.poses,
-              stamp_span_s, s.pose_rate_hz, s.metrics.position_rms_m);
-  // Started ~5 s into a 20 s run: localizing within ~3 s of its start leaves >= 12 s of poses.
+              stamp_span_s, stamp_rate_hz(poses), s.metrics.position_rms_m);
   EXPECT_GE(stamp_span_s, 12.0);
   EXPECT_EQ(s.metrics.samples_without_truth, 0u);
-  EXPECT_GE(s.pose_rate_hz, 90.0);
+  EXPECT_GE(stamp_rate_hz(poses), 90.0);  // a pose for (nearly) every odometry sample
   EXPECT_LE(s.metrics.position_rms_m, 0.15);
 }
 
@@ -110,9 +117,13 @@ TEST_F(Pipeline, TwoRobotsShareTheTopicsWithoutCrosstalk) {
   ChildProcess second(command("gateway", {"--robot", "beta", "--duration-s", "15", "--seed", "8",
                                           "--truth-out", path("beta.csv")}),
                       path("beta.log"));
-  // Not a wait for anything: alpha drives the same loop ~3 s (1 m) behind beta, so that poses
-  // mixed up between the robots would show as errors.
-  std::this_thread::sleep_for(3s);
+  // alpha drives the same loop >= 3 s (1 m) behind beta, so that poses mixed up between the
+  // robots would show as errors: it starts once beta has written 3 s of samples (odometry at
+  // 100 Hz, 15 TOFs a second; the beacon map), by beta's own count, however slowly beta started.
+  const auto beta_ahead =
+      wait_for_diagnostics(diagnostics, "beaconloc.gateway.beta",
+                           [](const msg::Diagnostics& d) { return d.accepted() >= kBetaAhead; });
+  ASSERT_GE(beta_ahead.accepted(), kBetaAhead) << second.log();
   ChildProcess first(command("gateway", {"--robot", "alpha", "--duration-s", "15", "--seed", "7",
                                          "--truth-out", path("alpha.csv")}),
                      path("alpha.log"));
@@ -129,8 +140,8 @@ TEST_F(Pipeline, TwoRobotsShareTheTopicsWithoutCrosstalk) {
     const PoseRunSummary s = summarize(by_robot[robot], truth);
     // Poses are stamped with the robot's own odometry stamps: each must match one exactly.
     for (const auto& p : by_robot[robot]) ASSERT_TRUE(truth.at(p.row.estimate.stamp_ns, 0)) << robot;
-    std::printf("%s: %zu poses at %.1f Hz, position RMS %.3f m\n", robot, s.poses, s.pose_rate_hz,
-                s.metrics.position_rms_m);
+    std::printf("%s: %zu poses at %.1f Hz, position RMS %.3f m\n", robot, s.poses,
+                stamp_rate_hz(by_robot[robot]), s.metrics.position_rms_m);
     EXPECT_GT(s.poses, 1000u) << robot;
     EXPECT_LE(s.metrics.position_rms_m, 0.15) << robot;
   }

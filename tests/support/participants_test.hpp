@@ -52,6 +52,41 @@ inline bool wait_for_pose(const PoseRecorder& recorder, const std::string& robot
       timeout);
 }
 
+// Waits until `robot` has been localized over `span` of its own time: its first pose, then one
+// `span` later by stamp, for a gateway that runs until the test stops it. How long the localizer
+// took to start and find the robot costs no pose span. False on timeout (scaled() by kTimeScale):
+// `first_pose` for the first pose, then the span plus `first_pose` for the rest.
+inline bool wait_for_pose_span(const PoseRecorder& recorder, const std::string& robot,
+                               std::chrono::milliseconds span,
+                               std::chrono::milliseconds first_pose = std::chrono::seconds(30)) {
+  StampNs first_ns = 0;
+  const bool localized = eventually(
+      [&] {
+        for (const auto& p : recorder.poses()) {
+          if (p.row.robot_id == robot) {
+            first_ns = p.row.estimate.stamp_ns;
+            return true;
+          }
+        }
+        return false;
+      },
+      first_pose);
+  return localized &&
+         wait_for_pose(recorder, robot, first_ns + span.count() * kNsPerMillisecond, span + first_pose);
+}
+
+// Poses per second of the poses' own stamps (the gateway's odometry clock), not of their arrival:
+// how completely the localizer kept up, whatever bunching a loaded machine gave the deliveries.
+// The poses of one robot; 0 for fewer than two.
+inline double stamp_rate_hz(const std::vector<RecordedPose>& poses) {
+  if (poses.size() < 2) return 0.0;
+  const auto [first, last] = std::minmax_element(
+      poses.begin(), poses.end(),
+      [](const auto& a, const auto& b) { return a.row.estimate.stamp_ns < b.row.estimate.stamp_ns; });
+  const double span_s = ns_to_s(last->row.estimate.stamp_ns - first->row.estimate.stamp_ns);
+  return span_s > 0.0 ? static_cast<double>(poses.size() - 1) / span_s : 0.0;
+}
+
 class ParticipantsTest : public ::testing::Test {
  protected:
   explicit ParticipantsTest(std::string participant_profile = "beaconloc.loopback") {
@@ -90,6 +125,14 @@ class ParticipantsTest : public ::testing::Test {
     const auto code = gateway.wait(std::chrono::seconds(90));
     ASSERT_TRUE(code) << "gateway did not finish";
     EXPECT_EQ(*code, 0) << gateway.log();
+    EXPECT_TRUE(wait_for_pose(recorder, robot, last_truth_stamp_ns(truth_csv)))
+        << robot << ": no pose at the run's last odometry stamp";
+  }
+  // Stops a gateway that runs until stopped (--duration-s 0), then waits for the pipeline to drain
+  // as finish_gateway does.
+  static void stop_gateway(ChildProcess& gateway, const PoseRecorder& recorder, const std::string& robot,
+                           const std::string& truth_csv) {
+    ASSERT_NO_FATAL_FAILURE(stop_cleanly(gateway, "gateway"));
     EXPECT_TRUE(wait_for_pose(recorder, robot, last_truth_stamp_ns(truth_csv)))
         << robot << ": no pose at the run's last odometry stamp";
   }
