@@ -28,6 +28,10 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
   map_events.on_writer_gone = [this](const std::string& writer) {
     std::lock_guard<std::mutex> lock(mutex_);
     map_sources_.on_writer_gone(writer);
+    // The writers left agree: their map is the site's, whichever arrived last before.
+    if (const auto agreed = map_sources_.agreed_map(); agreed && !(*agreed == core_.beacon_map())) {
+      core_.set_beacon_map(*agreed);
+    }
   };
   participant_.subscribe_with_info<msg::BeaconMapPubSubType>(
       dds::kBeaconMapTopic,
@@ -157,6 +161,8 @@ void LocalizerParticipant::publish(const LocalizerOutput& out) {
   }
   PoseEstimate estimate = out.estimate;
   estimate.status = conflicts_.status_of(out.robot_id, estimate.status);
+  // Against one of two disagreeing maps, a pose is no better than the map it was computed on.
+  if (map_sources_.disagree() && estimate.status == PoseStatus::kOk) estimate.status = PoseStatus::kDegraded;
   auto p = dds::to_msg(out.robot_id, estimate, core_.estimator_name(), out.beacons_used);
   pose_writer_->write(&p);
   ++poses_written_;
@@ -199,7 +205,7 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
     message += "; beacon map replaced " + std::to_string(core_.beacon_map_changes()) +
                " time(s), every robot restarted on it";
   }
-  if (map_sources_.distinct_maps() > 1) {
+  if (map_sources_.disagree()) {
     // Whichever map arrived last is in use; the robots flip between layouts as the maps arrive.
     status = msg::PARTICIPANT_STATUS_DEGRADED;
     message = "beacon maps disagree: " + map_sources_.describe() + ", the newest is in use; " + message;

@@ -61,13 +61,6 @@ class BeaconMapOnTheBus : public ParticipantsTest {
   }
 };
 
-// How many times the localizer's Diagnostics say it replaced the beacon map (0 before the first).
-std::size_t beacon_map_replacements(const msg::Diagnostics& d) {
-  const std::string what = "beacon map replaced ";
-  const auto at = d.message().find(what);
-  return at == std::string::npos ? 0 : std::stoul(d.message().substr(at + what.size()));
-}
-
 // Localized again: 2 s of ok poses (100 Hz) after the map changed.
 constexpr std::size_t kRelocalized = 200;
 
@@ -122,30 +115,49 @@ TEST_F(BeaconMapOnTheBus, AGatewayWithFewerBeaconsReplacesTheMapAndTheLocalizerG
     const std::string from = "{id: 1, position_m: [0.0,";
     return line.find(from) == std::string::npos ? line : "  - {id: 1, position_m: [0.5, -0.3, 2.011]}";
   });
-  ChildProcess a(command("gateway", {"--seed", "5", "--robot", "robot1"}), path("gateway3.log"));
+  ChildProcess a(command("gateway", {"--seed", "5", "--robot", "robot1", "--truth-out", path("site.csv")}),
+                 path("gateway3.log"));
   ChildProcess b(command("gateway", {"--scenario", moved, "--seed", "6", "--robot", "robot2"}),
                  path("gateway4.log"));
-  // Each map that differs from the one it holds replaces it: the first of the two replaces the
-  // three-beacon map, the second (unless the topic's newest-only history dropped the first)
-  // replaces that. Both robots are localized on the map it keeps: ok poses after its report of
-  // its last replacement (checked again once they came: the second map may have come since).
-  auto kept = wait_for_diagnostics(diagnostics, kLocalizer,
-                                   [](const msg::Diagnostics& d) { return beacon_map_replacements(d) >= 2; });
-  ASSERT_GE(beacon_map_replacements(kept), 2u) << kept.message() << "\n" << localizer.log();
-  for (int round = 0; round < 3; ++round) {
-    for (const char* robot : {"robot1", "robot2"}) {
-      ASSERT_TRUE(eventually(
-          [&] { return ok_poses_after(poses, robot, kept.stamp_ns()).size() >= kRelocalized; }, 30s))
-          << robot << " not localized with two maps on the bus\n"
-          << localizer.log();
+  // Two live gateways whose maps disagree: one of them is wrong, so the localizer says so and no
+  // pose of either robot is ok (each is computed on whichever map came last).
+  auto disagree = [](const msg::Diagnostics& d) {
+    return d.message().find("beacon maps disagree: 2 writers publish 2 different beacon maps") != std::string::npos;
+  };
+  const auto conflict = wait_for_diagnostics(diagnostics, kLocalizer, disagree);
+  ASSERT_TRUE(disagree(conflict)) << conflict.message() << "\n" << localizer.log();
+  EXPECT_EQ(conflict.status(), msg::PARTICIPANT_STATUS_DEGRADED);
+  auto poses_after = [&](const std::string& robot, StampNs from_ns) {
+    std::vector<RecordedPose> out;
+    for (const auto& p : poses.poses()) {
+      if (p.row.robot_id == robot && p.row.estimate.stamp_ns > from_ns) out.push_back(p);
     }
-    const auto now = diagnostics.latest().at(kLocalizer);
-    if (beacon_map_replacements(now) == beacon_map_replacements(kept)) break;
-    kept = now;
+    return out;
+  };
+  for (const char* robot : {"robot1", "robot2"}) {
+    // Poses made after the report (the gateways stamp with the wall clock, as the report is).
+    ASSERT_TRUE(eventually([&] { return poses_after(robot, conflict.stamp_ns()).size() >= 100; }, 30s))
+        << robot << "\n" << localizer.log();
+    for (const auto& p : poses_after(robot, conflict.stamp_ns())) {
+      ASSERT_NE(p.row.estimate.status, PoseStatus::kOk) << robot << " at " << p.row.estimate.stamp_ns;
+    }
   }
-  std::printf("two maps on the bus: %s\n", kept.message().c_str());
-  EXPECT_LE(beacon_map_replacements(kept), 3u);
-  for (ChildProcess* g : {&a, &b}) ASSERT_NO_FATAL_FAILURE(stop_cleanly(*g, "gateway"));
+  std::printf("two maps on the bus: %s\n", conflict.message().c_str());
+  // The gateway with the moved beacon leaves: the map of the one left is the site's (whichever came
+  // last before), and its robot is localized on it again, right against its truth.
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(b, "gateway with the moved beacon"));
+  const auto agreed = wait_for_diagnostics(diagnostics, kLocalizer, [&](const msg::Diagnostics& d) {
+    return d.stamp_ns() > conflict.stamp_ns() && !disagree(d);
+  });
+  ASSERT_FALSE(disagree(agreed)) << agreed.message();
+  EXPECT_TRUE(eventually([&] { return ok_poses_after(poses, "robot1", agreed.stamp_ns()).size() >= kRelocalized; }, 30s))
+      << "not localized again once the maps agree\n"
+      << localizer.log();
+  ASSERT_NO_FATAL_FAILURE(stop_cleanly(a, "gateway"));
+  const auto on_site = error_against(ok_poses_after(poses, "robot1", agreed.stamp_ns()), path("site.csv"));
+  std::printf("once the maps agree: %zu ok poses, position RMS %.3f m\n", on_site.samples(), on_site.position_rms_m());
+  EXPECT_GE(on_site.samples(), kRelocalized);
+  EXPECT_LE(on_site.position_rms_m(), 0.1);
   stop_cleanly(localizer, "localizer");
   stop_cleanly(decoder, "decoder");
   for (const auto& p : poses.poses()) ASSERT_TRUE(publishable(p.row.estimate));

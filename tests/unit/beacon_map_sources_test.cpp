@@ -19,18 +19,25 @@ TEST(BeaconMapSources, WritersThatPublishDifferentMapsDisagreeUntilOneLeavesOrTh
   EXPECT_EQ(sources.distinct_maps(), 1u);
   sources.on_map("gateway_b", site);  // a second gateway with the same map: no conflict
   EXPECT_EQ(sources.distinct_maps(), 1u);
+  ASSERT_TRUE(sources.agreed_map());
+  EXPECT_EQ(*sources.agreed_map(), site);
   sources.on_map("gateway_b", moved);
   EXPECT_EQ(sources.distinct_maps(), 2u);
+  EXPECT_TRUE(sources.disagree());
+  EXPECT_FALSE(sources.agreed_map());
   EXPECT_EQ(sources.describe(), "2 writers publish 2 different beacon maps");
   sources.on_map("gateway_b", site);  // it agrees again
   EXPECT_EQ(sources.distinct_maps(), 1u);
   sources.on_map("gateway_c", moved);
   EXPECT_EQ(sources.distinct_maps(), 2u);
-  sources.on_writer_gone("gateway_c");
-  EXPECT_EQ(sources.distinct_maps(), 1u);
   sources.on_writer_gone("gateway_a");
   sources.on_writer_gone("gateway_b");
+  EXPECT_EQ(sources.distinct_maps(), 1u);  // the one left: its map is agreed
+  ASSERT_TRUE(sources.agreed_map());
+  EXPECT_EQ(*sources.agreed_map(), moved);
+  sources.on_writer_gone("gateway_c");
   EXPECT_EQ(sources.distinct_maps(), 0u);
+  EXPECT_FALSE(sources.agreed_map());
 }
 
 }  // namespace

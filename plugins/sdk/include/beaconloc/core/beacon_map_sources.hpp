@@ -3,10 +3,12 @@
 // map; a participant takes whichever arrives last. Two live gateways with different maps (a
 // misconfigured site, a gateway started with the wrong scenario) would flip a robot between two
 // beacon layouts silently: they are a conflict to report instead (Diagnostics degraded, naming
-// it), until all but one writer are gone or they publish the same map. Keyed by writer id;
+// it, and no pose "ok": one of the maps is wrong), until all but one writer are gone or they
+// publish the same map; then the map they agree on is the one to use. Keyed by writer id;
 // bounded by the writers the bus matches. DDS-free.
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "beaconloc/core/beacon_map.hpp"
@@ -20,12 +22,17 @@ class BeaconMapSources {
   // The writer left the bus (unmatched, or its liveliness lapsed).
   void on_writer_gone(const std::string& writer);
   // How many different maps the live writers publish (0 before any map, 1 when they agree).
-  std::size_t distinct_maps() const;
+  std::size_t distinct_maps() const { return distinct_maps_; }
+  bool disagree() const { return distinct_maps_ > 1; }
+  // The one map every live writer publishes; nullopt when none does or they disagree.
+  std::optional<BeaconMap> agreed_map() const;
   // "N writers publish M different beacon maps", for a Diagnostics message.
   std::string describe() const;
 
  private:
+  void count_distinct_maps();
   std::map<std::string, BeaconMap> by_writer_;
+  std::size_t distinct_maps_ = 0;
 };
 
 }  // namespace beaconloc
