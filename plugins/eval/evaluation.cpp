@@ -178,6 +178,12 @@ std::vector<EstimateRow> load_estimates_csv(const std::string& path) {
     }
     r.estimate.status = status_from(csv.cell("status"), csv.where());
     r.estimator = csv.cell("estimator");
+    // Refused here, where the file and line are known, as every reader of poses refuses it
+    // (found by fuzz_eval_csv: an asymmetric covariance loaded, then evaluate() threw).
+    if (!publishable(r.estimate)) {
+      throw CsvError(csv.where() + ": not a pose a localizer publishes (a covariance that is not symmetric "
+                                   "with non-negative variances, or a variance beyond (1000 km)^2)");
+    }
     rows.push_back(r);
   }
   return rows;

@@ -225,5 +225,34 @@ TEST(FuzzRegression, EvaluationOfStampsAtBothEndsOfTheClockDoesNotOverflow) {
   EXPECT_DOUBLE_EQ(errors[1].t_s, 1.8e10);
 }
 
+// fuzz_eval_csv (600 s run, issue 23): an estimate row whose covariance is not symmetric
+// (cov_01 0.001, cov_10 0.1) loaded, and evaluate() then threw std::invalid_argument out of
+// `beaconloc eval`; the loader refuses it as a CsvError naming the line, as every pose reader does.
+TEST(FuzzRegression, EstimateCsvRefusesAPoseNoLocalizerPublishes) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("beaconloc_fuzz_estimate_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string header =
+      "robot_id,stamp_ns,x_m,y_m,yaw_rad,cov_00,cov_01,cov_02,cov_10,cov_11,cov_12,cov_20,cov_21,cov_22,status,"
+      "estimator\n";
+  const std::string good = "robot_0,1050000000,0.51,0.49,0.1,0.01,0,0,0,0.01,0,0,0,0.02,ok,range_ekf\n";
+  for (const std::string& bad : {std::string("robot_0,1150000000,0.55,0.5,0.13,1.01,0.001,0,000.1,0.01,0,0,0,0.02,"
+                                             "degraded,range_ekf\n"),
+                                 std::string("robot_0,1150000000,0.55,0.5,0.13,-1,0,0,0,0.01,0,0,0,0.02,ok,e\n"),
+                                 std::string("robot_0,1150000000,0.55,0.5,0.13,1e300,0,0,0,0.01,0,0,0,0.02,ok,e\n")}) {
+    std::ofstream(dir / "estimate.csv") << header << good << bad;
+    try {
+      load_estimates_csv((dir / "estimate.csv").string());
+      FAIL() << "loaded: " << bad;
+    } catch (const CsvError& e) {
+      EXPECT_NE(std::string(e.what()).find("estimate.csv:3: not a pose a localizer publishes"), std::string::npos)
+          << e.what();
+    }
+  }
+  std::ofstream(dir / "estimate.csv") << header << good;
+  EXPECT_EQ(load_estimates_csv((dir / "estimate.csv").string()).size(), 1u);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace beaconloc
