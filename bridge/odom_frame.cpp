@@ -16,23 +16,25 @@ bool OdomFrame::push(StampNs stamp_ns, const Pose2& pose) {
 }
 
 InputResult OdomFrame::add_wheel_odometry(const OdometrySample& o) {
-  // The estimators' checks: an absurd speed integrated here would put odom -> base_link, and the
-  // twist the bridge publishes, at infinity.
-  if (InputResult checked = check_odometry_numbers(o); !checked.accepted) return checked;
-  Pose2 pose = Pose2::Zero();
-  if (!poses_.empty()) {
-    if (o.stamp_ns <= poses_.back().first) return InputResult::rejected("out_of_order_odometry");
-    const double dt = static_cast<double>(o.stamp_ns - poses_.back().first) * 1e-9;
-    pose = predict_diff_drive(poses_.back().second, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
-                              o.wheel_base_m, dt)
+  // The estimators' checks and time line (core/odometry_timeline.hpp): an absurd speed integrated
+  // here would put odom -> base_link, and the twist the bridge publishes, at infinity; a gap is
+  // not integrated (the velocities describe only the last period) but re-anchors the frame where
+  // it was, so that a clock that steps forward does not freeze it.
+  const OdometryTimeline::Step step = timeline_.advance(o);
+  const bool gap = !step.result.accepted && step.result.rejection == "odometry_gap";
+  if (!step.result.accepted && !gap) return step.result;
+  Pose2 pose = poses_.empty() ? Pose2::Zero() : poses_.back().second;
+  if (step.integrate) {
+    pose = predict_diff_drive(pose, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps, o.wheel_base_m,
+                              step.dt_s)
                .pose;
   }
-  // Bounded speeds over any gap keep the pose finite; beyond a site's extent it says nothing.
+  // At most 10 m/s for 200 ms a sample: beyond a site's extent only after days of driving.
   if (!within_site(pose)) return InputResult::rejected("implausible_odom_pose");
   v_mps_ = (o.wheel_velocity_right_mps + o.wheel_velocity_left_mps) / 2.0;
   omega_radps_ = (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / o.wheel_base_m;
   push(o.stamp_ns, pose);
-  return InputResult::ok();
+  return step.result;  // accepted, or odometry_gap (taken, not integrated)
 }
 
 bool OdomFrame::within_site(const Pose2& pose) {

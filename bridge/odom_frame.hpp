@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/odometry_timeline.hpp"
 #include "beaconloc/core/measurements.hpp"
 #include "beaconloc/core/pose2.hpp"
 
@@ -14,11 +15,15 @@ namespace beaconloc::bridge {
 
 class OdomFrame {
  public:
-  explicit OdomFrame(StampNs history_ns = 2'000'000'000) : history_ns_(history_ns) {}
+  explicit OdomFrame(StampNs history_ns = 2'000'000'000) : history_ns_(history_ns), timeline_(kMaxIntegratedGapS) {}
   // Integrates wheel velocities (eq. 14 of seed 000) from the previous sample; the first sample
-  // anchors the frame at the origin. Refused with the estimators' reasons (check_odometry_numbers),
-  // out_of_order_odometry, or implausible_odom_pose (beyond a site's extent).
+  // anchors the frame at the origin. Checked as the estimators check odometry (OdometryTimeline):
+  // refused with their reasons (implausible_wheel_speed, out_of_order_odometry, ...), or
+  // implausible_odom_pose beyond a site's extent; a gap over kMaxIntegratedGapS is taken without
+  // integrating it (the frame stays where it was) and reported as odometry_gap.
   InputResult add_wheel_odometry(const OdometrySample& o);
+  // The estimators' default max_odometry_gap_s: a longer gap is not integrated.
+  static constexpr double kMaxIntegratedGapS = 0.2;
   // A driver's own odom -> base pose (finite, within a site's extent), and its finite twist.
   bool add_odom_pose(StampNs stamp_ns, const Pose2& pose_odom_base, double v_mps, double omega_radps);
   // odom -> base at stamp_ns, interpolated between neighbours; nullopt outside the history.
@@ -37,6 +42,7 @@ class OdomFrame {
   bool push(StampNs stamp_ns, const Pose2& pose);
   static bool within_site(const Pose2& pose);
   StampNs history_ns_;
+  OdometryTimeline timeline_;  // of the wheel odometry (add_wheel_odometry)
   std::deque<std::pair<StampNs, Pose2>> poses_;
   double v_mps_ = 0.0;
   double omega_radps_ = 0.0;

@@ -373,6 +373,12 @@ int run(int argc, char** argv) {
       }
       const std::string table =
           accuracy_table == "distance" ? distance_table_markdown(rows) : accuracy_table_markdown(rows);
+      // The file first: a reader of stdout that leaves early (`| head`) ends the command (SIGPIPE).
+      if (!accuracy_out.empty()) {
+        std::ofstream out(accuracy_out);
+        out << table;
+        if (!out.flush()) throw std::runtime_error("writing '" + accuracy_out + "' failed");
+      }
       std::cout << table;
       if (variants_compared) {
         // What the faults cost: the typed refusals of the decoder and localizer, over all seeds.
@@ -383,11 +389,6 @@ int run(int argc, char** argv) {
           for (const auto& [reason, n] : row.rejections) std::cout << ' ' << reason << '=' << n;
           std::cout << '\n';
         }
-      }
-      if (!accuracy_out.empty()) {
-        std::ofstream out(accuracy_out);
-        out << table;
-        if (!out.flush()) throw std::runtime_error("writing '" + accuracy_out + "' failed");
       }
       if (!failed_runs.empty()) {
         std::cerr << "beaconloc accuracy: " << failed_runs.size()

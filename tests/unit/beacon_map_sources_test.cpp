@@ -38,6 +38,12 @@ TEST(BeaconMapSources, WritersThatPublishDifferentMapsDisagreeUntilOneLeavesOrTh
   sources.on_writer_gone("gateway_c");
   EXPECT_EQ(sources.distinct_maps(), 0u);
   EXPECT_FALSE(sources.agreed_map());
+  // A gone writer's last map told after its leaving (two threads) does not bring it back.
+  sources.on_map("gateway_d", site);
+  sources.on_map("gateway_a", moved);
+  EXPECT_FALSE(sources.disagree());
+  ASSERT_TRUE(sources.agreed_map());
+  EXPECT_EQ(*sources.agreed_map(), site);
 }
 
 }  // namespace

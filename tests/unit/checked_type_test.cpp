@@ -71,8 +71,8 @@ TEST(CheckedType, ARangeAssociationTheIdlDoesNotDefineIsRefusedNotReadAsIdentifi
   }
 }
 
-TEST(CheckedType, AStringWithAControlCharacterIsRefusedOnEveryTopic) {
-  const std::string forged[] = {"robot1\nmonitor: 0 poses", "\x1b[2Jr", "r\x7f", "r\tb"};
+TEST(CheckedType, AStringWithAControlCharacterOrANameThatBreaksACsvCellIsRefusedOnEveryTopic) {
+  const std::string forged[] = {"robot1\nmonitor: 0 poses", "\x1b[2Jr", "r\x7f", "r\tb", "r\xc2\x9b" "2J"};
   for (const std::string& bad : forged) {
     msg::Diagnostics d;
     d.participant("p");
@@ -93,7 +93,40 @@ TEST(CheckedType, AStringWithAControlCharacterIsRefusedOnEveryTopic) {
     msg::BeaconMap m;
     m.frame_id(bad);
     EXPECT_EQ(round_trip<msg::BeaconMapPubSubType>(m), std::make_pair(false, std::uint64_t{1}));
+    msg::InitialPose i;
+    i.robot_id(bad);
+    EXPECT_EQ(round_trip<msg::InitialPosePubSubType>(i), std::make_pair(false, std::uint64_t{1}));
+    msg::LaserScan l;
+    l.robot_id(bad);
+    EXPECT_EQ(round_trip<msg::LaserScanPubSubType>(l), std::make_pair(false, std::uint64_t{1}));
+    msg::BeaconRange r;
+    r.robot_id(bad);
+    EXPECT_EQ(round_trip<msg::BeaconRangePubSubType>(r), std::make_pair(false, std::uint64_t{1}));
+    p.robot_id("r");
+    p.estimator(bad);
+    EXPECT_EQ(round_trip<msg::PoseEstimatePubSubType>(p), std::make_pair(false, std::uint64_t{1}));
+    d.robots_localized({});
+    d.participant(bad);
+    EXPECT_EQ(round_trip<msg::DiagnosticsPubSubType>(d), std::make_pair(false, std::uint64_t{1}));
+    d.participant("p");
+    d.rejected({msg::RejectionCount()});
+    d.rejected()[0].reason(bad);
+    EXPECT_EQ(round_trip<msg::DiagnosticsPubSubType>(d), std::make_pair(false, std::uint64_t{1}));
   }
+  // A name that would shift the columns of a CSV file (written unquoted).
+  for (const std::string& bad : {std::string("r,1"), std::string("r\"1")}) {
+    msg::PoseEstimate p;
+    p.robot_id(bad);
+    EXPECT_EQ(round_trip<msg::PoseEstimatePubSubType>(p), std::make_pair(false, std::uint64_t{1})) << bad;
+    msg::Odometry o;
+    o.robot_id(bad);
+    EXPECT_EQ(round_trip<msg::OdometryPubSubType>(o), std::make_pair(false, std::uint64_t{1})) << bad;
+  }
+  // A message may hold commas and quotes: it is text, not a cell.
+  msg::Diagnostics text;
+  text.participant("p");
+  text.message("1 robot(s), worst pose status \"ok\"");
+  EXPECT_EQ(round_trip<msg::DiagnosticsPubSubType>(text), std::make_pair(true, std::uint64_t{0}));
   // UTF-8 and punctuation are names like any other.
   msg::PoseEstimate p;
   p.robot_id("röbot-7/base_link");

@@ -135,7 +135,10 @@ TEST(Ros2Bridge, MapToOdomComposesToTheEstimate) {
     o.stamp_ns = k * 10'000'000;
     ASSERT_TRUE(odom.add_wheel_odometry(o).accepted);
   }
-  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, "out_of_order_odometry");  // same stamp again
+  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, "duplicate_odometry");  // same stamp again
+  o.stamp_ns -= 5'000'000;
+  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, "out_of_order_odometry");
+  o.stamp_ns += 5'000'000;
   // The bus's odometry is checked as the estimators check it: an absurd speed never moves the
   // frame (it put odom -> base_link and the published twist at infinity).
   for (double v : {1e300, 1000.0}) {
@@ -158,6 +161,31 @@ TEST(Ros2Bridge, MapToOdomComposesToTheEstimate) {
   EXPECT_TRUE(odom.pose_odom_base(995'000'000)->isApprox(0.5 * (a + b), 1e-12));
   // Outside the history: none.
   EXPECT_FALSE(odom.pose_odom_base(2'000'000'000));
+}
+
+// A clock that steps forward (a gateway stamping data time replaced by one stamping wall-clock
+// time) is a gap: not integrated (1.7e9 s at 1 m/s put the frame beyond any site, and every later
+// sample was refused, freezing map -> odom), but taken, and the frame goes on from where it was.
+TEST(Ros2Bridge, TheOdomFrameGoesOnAcrossAClockStepForward) {
+  OdomFrame odom;
+  OdometrySample o;
+  o.wheel_base_m = 0.4;
+  o.wheel_velocity_right_mps = 1.0;
+  o.wheel_velocity_left_mps = 1.0;
+  for (int k = 0; k <= 10; ++k) {
+    o.stamp_ns = k * 10'000'000;
+    ASSERT_TRUE(odom.add_wheel_odometry(o).accepted);
+  }
+  const Pose2 before = *odom.pose_odom_base(100'000'000);
+  EXPECT_NEAR(before.x(), 0.1, 1e-9);
+  const StampNs jumped_ns = 1'700'000'000'000'000'000;
+  o.stamp_ns = jumped_ns;
+  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, "odometry_gap");
+  ASSERT_TRUE(odom.pose_odom_base(jumped_ns));
+  EXPECT_TRUE(odom.pose_odom_base(jumped_ns)->isApprox(before, 1e-12));  // not integrated
+  o.stamp_ns = jumped_ns + 10'000'000;
+  ASSERT_TRUE(odom.add_wheel_odometry(o).accepted);
+  EXPECT_NEAR(odom.pose_odom_base(o.stamp_ns)->x(), 0.11, 1e-9);  // and on from there
 }
 
 TEST(Ros2Bridge, BeaconMarkersAndRanges) {

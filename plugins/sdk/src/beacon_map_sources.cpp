@@ -1,16 +1,20 @@
 #include "beaconloc/core/beacon_map_sources.hpp"
 
+#include <algorithm>
 #include <vector>
 
 namespace beaconloc {
 
 void BeaconMapSources::on_map(const std::string& writer, const BeaconMap& map) {
+  if (std::find(gone_.begin(), gone_.end(), writer) != gone_.end()) return;
   by_writer_[writer] = map;
   count_distinct_maps();
 }
 
 void BeaconMapSources::on_writer_gone(const std::string& writer) {
   by_writer_.erase(writer);
+  gone_.push_back(writer);
+  if (gone_.size() > kKeptGone) gone_.pop_front();
   count_distinct_maps();
 }
 

@@ -5,11 +5,23 @@
 namespace beaconloc::dds {
 namespace {
 
+// No C0 control (0x00-0x1f), no DEL, no C1 control (U+0080-U+009F, 0xc2 0x80-0x9f in UTF-8: CSI
+// and its kin move a terminal's cursor as ESC [ does). Other UTF-8 is text like any other.
 bool printable(const std::string& s) {
-  return std::none_of(s.begin(), s.end(), [](char c) {
-    const auto u = static_cast<unsigned char>(c);
-    return u < 0x20 || u == 0x7f;
-  });
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const auto u = static_cast<unsigned char>(s[i]);
+    if (u < 0x20 || u == 0x7f) return false;
+    if (u == 0xc2 && i + 1 < s.size()) {
+      const auto next = static_cast<unsigned char>(s[i + 1]);
+      if (next >= 0x80 && next <= 0x9f) return false;
+    }
+  }
+  return true;
+}
+
+// A name that is also a CSV cell as the files write it (unquoted): printable, no ',' and no '"'.
+bool identifier(const std::string& s) {
+  return printable(s) && s.find_first_of(",\"") == std::string::npos;
 }
 
 bool defined(msg::RangeAssociation a) {
@@ -44,29 +56,29 @@ bool defined(msg::ParticipantStatus s) {
 
 }  // namespace
 
-bool well_formed(const msg::RawTof& m) { return printable(m.robot_id()); }
+bool well_formed(const msg::RawTof& m) { return identifier(m.robot_id()); }
 
-bool well_formed(const msg::BeaconRange& m) { return printable(m.robot_id()) && defined(m.association()); }
+bool well_formed(const msg::BeaconRange& m) { return identifier(m.robot_id()) && defined(m.association()); }
 
-bool well_formed(const msg::Odometry& m) { return printable(m.robot_id()); }
+bool well_formed(const msg::Odometry& m) { return identifier(m.robot_id()); }
 
-bool well_formed(const msg::LaserScan& m) { return printable(m.robot_id()); }
+bool well_formed(const msg::LaserScan& m) { return identifier(m.robot_id()); }
 
 bool well_formed(const msg::PoseEstimate& m) {
-  return printable(m.robot_id()) && printable(m.estimator()) && defined(m.status());
+  return identifier(m.robot_id()) && identifier(m.estimator()) && defined(m.status());
 }
 
-bool well_formed(const msg::InitialPose& m) { return printable(m.robot_id()); }
+bool well_formed(const msg::InitialPose& m) { return identifier(m.robot_id()); }
 
 bool well_formed(const msg::BeaconMap& m) { return printable(m.frame_id()); }
 
 bool well_formed(const msg::Diagnostics& m) {
-  if (!printable(m.participant()) || !printable(m.message()) || !defined(m.status())) return false;
+  if (!identifier(m.participant()) || !printable(m.message()) || !defined(m.status())) return false;
   for (const auto& r : m.rejected()) {
     if (!printable(r.reason())) return false;
   }
   return std::all_of(m.robots_localized().begin(), m.robots_localized().end(),
-                     [](const std::string& robot) { return printable(robot); });
+                     [](const std::string& robot) { return identifier(robot); });
 }
 
 }  // namespace beaconloc::dds

@@ -7,6 +7,7 @@
 // publish the same map; then the map they agree on is the one to use. Keyed by writer id;
 // bounded by the writers the bus matches. DDS-free.
 #include <cstddef>
+#include <deque>
 #include <map>
 #include <optional>
 #include <string>
@@ -17,9 +18,10 @@ namespace beaconloc {
 
 class BeaconMapSources {
  public:
-  // A map taken from `writer` (a refused one is not a source).
+  // A map taken from `writer` (a refused one is not a source). A writer that has gone is no source
+  // either: its last map and its leaving may be told on two threads in either order.
   void on_map(const std::string& writer, const BeaconMap& map);
-  // The writer left the bus (unmatched, or its liveliness lapsed).
+  // The writer left the bus (unmatched, or its liveliness lapsed). Writer ids are never reused.
   void on_writer_gone(const std::string& writer);
   // How many different maps the live writers publish (0 before any map, 1 when they agree).
   std::size_t distinct_maps() const { return distinct_maps_; }
@@ -33,6 +35,9 @@ class BeaconMapSources {
   void count_distinct_maps();
   std::map<std::string, BeaconMap> by_writer_;
   std::size_t distinct_maps_ = 0;
+  // The writers gone, newest kKeptGone (a gateway restarted every minute for a year is 5e5 ids).
+  static constexpr std::size_t kKeptGone = 4096;
+  std::deque<std::string> gone_;
 };
 
 }  // namespace beaconloc

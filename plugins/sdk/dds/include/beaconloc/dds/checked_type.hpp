@@ -12,9 +12,11 @@
 //
 // A payload that reads but is not well formed is refused the same way: an enumeration value the
 // type does not define (Fast CDR reads an enum as a 32-bit integer and casts it unchecked: a
-// Diagnostics status of 7 printed as "ok", one of 0xFFFFFFFF indexed a table at -1), or a string
+// Diagnostics status of 7 printed as "ok", one of 0xFFFFFFFF indexed a table at -1), a string
 // with a control character (a robot id or a Diagnostics message carrying a newline or a terminal
-// escape sequence would forge lines in the monitor's output and rows in the CSV files). No reader
+// escape sequence would forge lines in the monitor's output and rows in the CSV files), or a name
+// (robot id, estimator, participant) with a ',' or '"' (it would shift the columns of the CSV
+// files, which write names unquoted). No reader
 // ever sees a value its switch does not list or a string it cannot print. well_formed() holds one
 // overload per beaconloc type; other types (the ROS 2 ones) are taken as they read.
 #include <beaconloc.h>
@@ -26,8 +28,8 @@
 
 namespace beaconloc::dds {
 
-// True when every enumeration field of `m` holds a value its IDL type defines and no string field
-// holds an ASCII control character.
+// True when every enumeration field of `m` holds a value its IDL type defines, no string field
+// holds a control character (C0, DEL, C1) and no name holds ',' or '"'.
 bool well_formed(const msg::RawTof& m);
 bool well_formed(const msg::BeaconRange& m);
 bool well_formed(const msg::Odometry& m);
