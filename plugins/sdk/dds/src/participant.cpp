@@ -97,8 +97,12 @@ Participant::~Participant() {
 }
 
 void Participant::close() {
-  if (publisher_) publisher_->delete_contained_entities();
+  // Readers first: a reader's callback may be writing (the localizer publishes a pose from its
+  // range callback); deleting a reader waits for its callback, and only then may the writers go.
+  // The other order let a range that arrived during a stop write through a deleted DataWriter
+  // (heap-use-after-free, found by the sanitizer leg of .ci/run).
   if (subscriber_) subscriber_->delete_contained_entities();
+  if (publisher_) publisher_->delete_contained_entities();
 }
 
 Topic* Participant::topic(const std::string& name, TopicDataType* type) {

@@ -196,7 +196,8 @@ class Participant {
   const std::string& name() const { return name_; }
   // Samples whose payload could not be read, on any topic (Fast DDS dropped them).
   std::uint64_t undecodable_samples() const { return undecodable_.load(); }
-  // Deletes readers and writers first: call before the listeners they use are destroyed.
+  // Deletes the readers (each waits for a callback under way), then the writers: call before the
+  // listeners they use are destroyed.
   void close();
 
  private:
