@@ -14,8 +14,11 @@ namespace {
 
 using namespace std::chrono_literals;
 
+// UDP on loopback alone: a participant killed with SIGKILL cannot remove its shared-memory
+// segments and port files from /dev/shm.
 class PeerLoss : public ParticipantsTest {
  protected:
+  PeerLoss() : ParticipantsTest("beaconloc.loopback_udp") {}
   static bool says(const msg::Diagnostics& d, const std::string& text) {
     return d.message().find(text) != std::string::npos;
   }
