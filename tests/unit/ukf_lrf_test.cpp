@@ -12,7 +12,7 @@
 #include "beaconloc/core/occupancy_grid_io.hpp"
 #include "exact_ranges.hpp"
 #include "ukf_lrf/beacon_association.hpp"
-#include "ukf_lrf/laser_model.hpp"
+#include "beaconloc/core/models/laser_beam_model.hpp"
 
 namespace beaconloc::ukf_lrf {
 namespace {

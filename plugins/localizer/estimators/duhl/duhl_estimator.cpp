@@ -6,6 +6,8 @@
 #include "beaconloc/core/estimator_parameters.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/models/diff_drive_motion.hpp"
+#include "beaconloc/core/models/linear_model.hpp"
+#include "beaconloc/core/models/pose_observation_model.hpp"
 
 namespace beaconloc::duhl {
 namespace {
@@ -87,9 +89,10 @@ InputResult Duhl::predict(const OdometrySample& o) {
   const Eigen::Matrix2d u =
       o.wheel_velocity_covariance + params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity();
   if (initialized_) {  // eq. 14, 16
-    const DiffDrivePrediction p = predict_diff_drive(ekf_.state(), o.wheel_velocity_right_mps,
-                                                     o.wheel_velocity_left_mps, o.wheel_base_m, step.dt_s);
-    ekf_.predict(p.pose, p.jacobian_pose, p.jacobian_wheels * u * p.jacobian_wheels.transpose());
+    const PredictResult predicted = ekf_.predict(
+        DiffDriveMotion(o.wheel_base_m, u), Eigen::Vector2d(o.wheel_velocity_right_mps, o.wheel_velocity_left_mps),
+        step.dt_s);
+    if (!predicted.applied()) return InputResult::rejected(to_string(predicted.outcome));
   }
   for (auto it = available_.begin(); it != available_.end();) {
     const double z = map_.find(it->first)->position_map_m.z() - ring_.height_m;
@@ -136,9 +139,8 @@ InputResult Duhl::update(const RangeMeasurement& r) {
   Eigen::Matrix<double, 1, 3> h = Eigen::Matrix<double, 1, 3>::Zero();
   h(r.receiver_id) = 1.0;
   const UpdateResult result =
-      q_filter.update<1>(Eigen::Matrix<double, 1, 1>(r.range_m - it->second.q(r.receiver_id)), h,
-                         Eigen::Matrix<double, 1, 1>(r.variance_m2), 1e12);
-  if (result.outcome != UpdateOutcome::kApplied) return InputResult::rejected("singular_innovation");
+      q_filter.update(LinearModel<1, 3>(h, Mat<1, 1>(r.variance_m2)), Vec<1>(r.range_m));
+  if (!result.applied()) return InputResult::rejected(to_string(result.outcome));
   it->second.q = q_filter.state();
   it->second.covariance = q_filter.covariance();
   // This receiver's distance now carries the measurement's own variance (eq. 27), and no longer
@@ -209,11 +211,8 @@ void Duhl::observe() {
     return;
   }
   // Eq. 17-20 with J_h,x = I.
-  const Eigen::Vector3d innovation = pose_difference(z.pose, ekf_.state());
-  const UpdateResult result =
-      ekf_.update<3>(innovation, Eigen::Matrix3d::Identity(), r, params_.observation_nis_gate);
-  if (result.outcome == UpdateOutcome::kApplied) {
-    ekf_.mutable_state().z() = wrap_angle_rad(ekf_.state().z());
+  const UpdateResult result = ekf_.update(PoseObservationModel(r), z.pose, params_.observation_nis_gate);
+  if (result.applied()) {
     last_correction_stamp_ns_ = now;
     consecutive_gated_ = 0;
   } else if (params_.reinitialize_after_gated > 0 &&

@@ -80,7 +80,7 @@ class Duhl final : public Estimator {
   StalenessPolicy staleness_;
   BeaconMap map_;
   OdometryTimeline timeline_;
-  Ekf<3> ekf_;
+  Ekf<3> ekf_{pose_space()};
   bool initialized_ = false;
   std::map<std::uint32_t, TxEstimate> available_;  // T_A and Q (eq. 30)
   bool pending_observation_ = false;

@@ -69,12 +69,13 @@ InputResult RangeEkf::predict(const OdometrySample& o) {
                                   o.wheel_base_m, dt_s)
                    .pose;
   if (initialized_) {
-    const DiffDrivePrediction p = predict_diff_drive(ekf_.state(), o.wheel_velocity_right_mps,
-                                                     o.wheel_velocity_left_mps, o.wheel_base_m, dt_s);
-    const Eigen::Matrix2d u = o.wheel_velocity_covariance +
-                              params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity();
-    // Eq. 16: P = J_f,x P J_f,x^T + J_f,u U J_f,u^T.
-    ekf_.predict(p.pose, p.jacobian_pose, p.jacobian_wheels * u * p.jacobian_wheels.transpose());
+    const DiffDriveMotion motion(o.wheel_base_m,
+                                 o.wheel_velocity_covariance +
+                                     params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity());
+    // Eq. 14, 16: P = J_f,x P J_f,x^T + J_f,u U J_f,u^T.
+    const PredictResult predicted = ekf_.predict(
+        motion, Eigen::Vector2d(o.wheel_velocity_right_mps, o.wheel_velocity_left_mps), dt_s);
+    if (!predicted.applied()) return InputResult::rejected(to_string(predicted.outcome));
   }
   return InputResult::ok();
 }
@@ -104,22 +105,19 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
 // localizer pushes in stamp order however late a range arrives (core/out_of_sequence_fusion).
 InputResult RangeEkf::fuse(const RangeMeasurement& r) {
   const Beacon& beacon = *map_.find(r.beacon_id);
-  const RangePrediction p = predict_range(ekf_.state(), receivers_.receivers_base_m[r.receiver_id],
-                                          receivers_.receiver_height_m, beacon.position_map_m);
-  const Eigen::Matrix<double, 1, 1> innovation(r.range_m - p.range_m);
-  const Eigen::Matrix<double, 1, 1> noise(r.variance_m2);
-  const UpdateResult result = ekf_.update<1>(innovation, p.jacobian_pose, noise, params_.nis_gate);
+  const RangeModel model(receivers_.receivers_base_m[r.receiver_id], receivers_.receiver_height_m,
+                         beacon.position_map_m, r.variance_m2);
+  const UpdateResult result = ekf_.update(model, RangeModel::Vector(r.range_m), params_.nis_gate);
   switch (result.outcome) {
-    case UpdateOutcome::kApplied:
-      ekf_.mutable_state().z() = wrap_angle_rad(ekf_.state().z());
+    case FilterOutcome::kApplied:
       consecutive_gated_ = 0;
       last_correction_stamp_ns_ = std::max(r.stamp_ns, timeline_.last_stamp_ns().value_or(r.stamp_ns));
       watch_divergence({false, result.nis});
       return InputResult::ok();
-    case UpdateOutcome::kSingularInnovation:
-      return InputResult::rejected("singular_innovation");
-    case UpdateOutcome::kGated:
+    case FilterOutcome::kGated:
       break;
+    default:
+      return InputResult::rejected(to_string(result.outcome));
   }
   ++consecutive_gated_;
   watch_divergence({true, result.nis});

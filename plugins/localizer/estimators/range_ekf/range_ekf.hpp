@@ -90,7 +90,7 @@ class RangeEkf final : public Estimator {
   RangeEkfParameters params_;
   StalenessPolicy staleness_;
   BeaconMap map_;
-  Ekf<3> ekf_;
+  Ekf<3> ekf_{pose_space()};
   bool initialized_ = false;
   OdometryTimeline timeline_;
   StampNs last_correction_stamp_ns_ = 0;

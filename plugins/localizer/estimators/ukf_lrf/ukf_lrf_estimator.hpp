@@ -16,7 +16,7 @@
 #include "beaconloc/core/estimator.hpp"
 #include "beaconloc/core/filters/unscented.hpp"
 #include "beaconloc/core/odometry_timeline.hpp"
-#include "laser_model.hpp"
+#include "beaconloc/core/models/laser_beam_model.hpp"
 
 namespace beaconloc::ukf_lrf {
 
