@@ -65,11 +65,13 @@ class Qos : public ParticipantsTest {
     return truth.samples().begin()->first - 10 * kNsPerMillisecond;
   }
   // Stops p (SIGSTOP) for about `d`, then lets it go on; returns how long it was stopped (this
-  // process may wake late on a busy machine).
-  static double stall(ChildProcess& p, std::chrono::milliseconds d) {
+  // process may wake late on a busy machine). continued_wall_ns: the wall time just before the
+  // SIGCONT, which everything p does after the stall follows.
+  static double stall(ChildProcess& p, std::chrono::milliseconds d, StampNs* continued_wall_ns = nullptr) {
     const auto from = std::chrono::steady_clock::now();
     p.signal(SIGSTOP);
     std::this_thread::sleep_for(d);
+    if (continued_wall_ns) *continued_wall_ns = dds::wall_clock_ns();
     p.signal(SIGCONT);
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - from).count();
   }
@@ -235,10 +237,13 @@ TEST_F(Qos, TofsOlderThanTheirLifespanAreNeverDecoded) {
   // Stalled once 2 s of ranges (15 a second) came through.
   ASSERT_TRUE(eventually([&] { return ranges.ranges().size() >= 30; }, 30s))
       << gateway.log() << decoder.log();
-  const double stalled_s = stall(decoder, 1500ms);
-  // Taken once it goes on (this process may have sent SIGCONT late): ages at the resume are then
-  // no younger than they were.
-  const StampNs resumed_wall_ns = dds::wall_clock_ns();
+  // The resume is the wall time just before the SIGCONT: every range the decoder sends after the
+  // stall is received after it. (Taken after the signal, it was later than a backlog the decoder
+  // had already sent when this process, on a loaded machine, ran again: none counted, CI run with
+  // a CPU hog.) A backlog TOF is at least as old when the decoder takes it as it was then, so an
+  // age over the lifespan here is one the decoder's reader let through.
+  StampNs resumed_wall_ns = 0;
+  const double stalled_s = stall(decoder, 1500ms, &resumed_wall_ns);
   // The backlog is through once ranges of TOFs fired after the resume come (one writer: in order).
   ASSERT_TRUE(eventually(
       [&] {
