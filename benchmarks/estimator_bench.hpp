@@ -94,7 +94,7 @@ inline InputResult push(Estimator& e, const Input& in) {
     case Input::Kind::kScan:
       return e.update_laser(in.scan);
   }
-  return InputResult::rejected("unknown_input");
+  throw std::logic_error("unknown input kind");
 }
 
 // An estimator as it was at a moment of the run, and the inputs of the step timed from there.
@@ -145,9 +145,9 @@ inline void require_accepted(const Snapshot& s, const std::string& what) {
   auto e = s.estimator->clone();
   for (const Input& in : s.step) {
     const InputResult r = push(*e, in);
-    if (!r.accepted) throw std::logic_error(what + ": input refused (" + r.rejection + ")");
+    if (!r.accepted) throw std::logic_error(what + ": input refused (" + std::string(to_string(*r.rejection)) + ")");
   }
-  for (const auto& r : e->take_deferred_rejections()) throw std::logic_error(what + ": deferred " + r);
+  for (const auto& r : e->take_deferred_rejections()) throw std::logic_error(what + ": deferred " + to_string(r));
 }
 
 // One timed step: its inputs pushed in order. Out of line, so that a profiler can count it alone

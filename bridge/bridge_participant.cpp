@@ -169,7 +169,7 @@ void BridgeParticipant::on_odometry(const msg::Odometry& m) {
   if (m.robot_id() != options_.robot_id || options_.odometry_in) return;  // the driver's pose is used then
   std::lock_guard<std::mutex> lock(mutex_);
   if (const InputResult added = odom_.add_wheel_odometry(dds::from_msg(m)); !added.accepted) {
-    counts_.reject("odometry." + added.rejection);
+    counts_.reject("odometry.", *added.rejection);
   }
   publish_pending_transforms();
 }

@@ -21,7 +21,7 @@ InputResult OdomFrame::add_wheel_odometry(const OdometrySample& o) {
   // not integrated (the velocities describe only the last period) but re-anchors the frame where
   // it was, so that a clock that steps forward does not freeze it.
   const OdometryTimeline::Step step = timeline_.advance(o);
-  const bool gap = !step.result.accepted && step.result.rejection == "odometry_gap";
+  const bool gap = !step.result.accepted && step.result.rejection == Rejection::kOdometryGap;
   if (!step.result.accepted && !gap) return step.result;
   Pose2 pose = poses_.empty() ? Pose2::Zero() : poses_.back().second;
   if (step.integrate) {
@@ -30,7 +30,7 @@ InputResult OdomFrame::add_wheel_odometry(const OdometrySample& o) {
                .pose;
   }
   // At most 10 m/s for 200 ms a sample: beyond a site's extent only after days of driving.
-  if (!within_site(pose)) return InputResult::rejected("implausible_odom_pose");
+  if (!within_site(pose)) return InputResult::rejected(Rejection::kImplausibleOdomPose);
   v_mps_ = (o.wheel_velocity_right_mps + o.wheel_velocity_left_mps) / 2.0;
   omega_radps_ = (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / o.wheel_base_m;
   push(o.stamp_ns, pose);

@@ -123,7 +123,7 @@ std::optional<OdometrySample> from_ros_odometry(const nav_msgs::msg::Odometry& m
   // What the localizer would refuse is refused here, by the same checks and reasons: a huge
   // finite twist is an infinite wheel speed on the bus.
   if (const InputResult checked = check_odometry_numbers(o); !checked.accepted) {
-    return refused<OdometrySample>(why_not, checked.rejection);
+    return refused<OdometrySample>(why_not, to_string(*checked.rejection));
   }
   return o;
 }

@@ -9,38 +9,12 @@
 
 namespace beaconloc {
 
-const char* to_string(TofRejection r) {
-  switch (r) {
-    case TofRejection::kNonFiniteTof:
-      return "non_finite_tof";
-    case TofRejection::kNegativeTof:
-      return "negative_tof";
-    case TofRejection::kOutOfRangeTof:
-      return "out_of_range_tof";
-    case TofRejection::kBadTemperature:
-      return "bad_temperature";
-    case TofRejection::kNoBeaconMap:
-      return "no_beacon_map";
-    case TofRejection::kUnknownBeacon:
-      return "unknown_beacon";
-    case TofRejection::kStale:
-      return "stale";
-    case TofRejection::kDuplicate:
-      return "duplicate";
-    case TofRejection::kBadStamp:
-      return "bad_stamp";
-    case TofRejection::kTimeJump:
-      return "time_jump";
-  }
-  return "unknown_reason";
-}
-
 // Seed 000, Section II-A: distance = c(T) * TOF, with the ranging system's calibration.
 double TofDecoder::range_of(const RawTofSample& tof) const {
   return speed_of_sound_mps(tof.beacon_temperature_c) * tof.tof_s / config_.range_scale;
 }
 
-DecodeOutcome TofDecoder::reject(TofRejection r) {
+DecodeOutcome TofDecoder::reject(Rejection r) {
   counts_.reject(to_string(r));
   DecodeOutcome out;
   out.rejection = r;
@@ -63,19 +37,19 @@ TofDecoder::TofDecoder(TofDecoderConfig config) : config_(config) {
 }
 
 DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample& tof) {
-  if (!std::isfinite(tof.tof_s)) return reject(TofRejection::kNonFiniteTof);
-  if (!(tof.tof_s > 0.0)) return reject(TofRejection::kNegativeTof);
+  if (!std::isfinite(tof.tof_s)) return reject(Rejection::kNonFiniteTof);
+  if (!(tof.tof_s > 0.0)) return reject(Rejection::kNegativeTof);
   const double t_c = tof.beacon_temperature_c;
   if (!std::isfinite(t_c) || t_c < config_.min_temperature_c || t_c > config_.max_temperature_c) {
-    return reject(TofRejection::kBadTemperature);
+    return reject(Rejection::kBadTemperature);
   }
   const double range_m = range_of(tof);
   if (range_m < config_.min_range_m || range_m > config_.max_range_m) {
-    return reject(TofRejection::kOutOfRangeTof);
+    return reject(Rejection::kOutOfRangeTof);
   }
   // The arrival, fire stamp + TOF, must be a stamp too (the TOF bound keeps s_to_ns defined).
   if (tof.tof_s >= 9e9 || tof.fire_stamp_ns > std::numeric_limits<StampNs>::max() - s_to_ns(tof.tof_s)) {
-    return reject(TofRejection::kBadStamp);
+    return reject(Rejection::kBadStamp);
   }
   if (tof.beacon_id != kBeaconUnidentified && map_.empty()) {
     // Hold it for the map; what ages out of the backlog, or overflows it, is refused.
@@ -83,7 +57,7 @@ DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample
            (backlog_.size() >= kMaxBacklog ||
             older_than(backlog_.front().second.fire_stamp_ns, tof.fire_stamp_ns, config_.max_age_ns))) {
       backlog_.pop_front();
-      counts_.reject(to_string(TofRejection::kNoBeaconMap));
+      counts_.reject(to_string(Rejection::kNoBeaconMap));
     }
     backlog_.emplace_back(robot_id, tof);
     DecodeOutcome out;
@@ -114,7 +88,7 @@ std::vector<DecodedRange> TofDecoder::set_beacon_map(const BeaconMap& map) {
 DecodeOutcome TofDecoder::decode_with_map(const std::string& robot_id, const RawTofSample& tof,
                                           double range_m) {
   const bool identified = tof.beacon_id != kBeaconUnidentified;
-  if (identified && !map_.find(tof.beacon_id)) return reject(TofRejection::kUnknownBeacon);
+  if (identified && !map_.find(tof.beacon_id)) return reject(Rejection::kUnknownBeacon);
 
   RobotState& robot = robots_[robot_id];
   bool new_time_line = false;
@@ -129,18 +103,18 @@ DecodeOutcome TofDecoder::decode_with_map(const std::string& robot_id, const Raw
                     !older_than(*candidate, tof.fire_stamp_ns, config_.max_age_ns);
     if (!new_time_line) {
       robot.jump_candidate_ns = tof.fire_stamp_ns;
-      return reject(TofRejection::kTimeJump);
+      return reject(Rejection::kTimeJump);
     }
     robot.recent.clear();
     robot.jump_candidate_ns.reset();
   } else if (robot.seen_any &&
              older_than(tof.fire_stamp_ns, robot.newest_fire_stamp_ns, config_.max_age_ns)) {
-    return reject(TofRejection::kStale);
+    return reject(Rejection::kStaleTof);
   }
   if (!new_time_line) robot.jump_candidate_ns.reset();  // a firing on the time line: no jump pending
   const auto key = std::make_pair(tof.sequence_number, tof.fire_stamp_ns);
   if (std::find(robot.recent.begin(), robot.recent.end(), key) != robot.recent.end()) {
-    return reject(TofRejection::kDuplicate);
+    return reject(Rejection::kDuplicateTof);
   }
   robot.recent.push_back(key);
   if (robot.recent.size() > 64) robot.recent.pop_front();

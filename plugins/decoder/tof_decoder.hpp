@@ -11,23 +11,18 @@
 
 #include "beaconloc/core/beacon_map.hpp"
 #include "beaconloc/core/measurements.hpp"
+#include "beaconloc/core/rejection.hpp"
 #include "beaconloc/core/rejection_counter.hpp"
 
 namespace beaconloc {
 
-enum class TofRejection {
-  kNonFiniteTof,    // NaN or Inf TOF
-  kNegativeTof,     // TOF < 0 (or exactly 0: no flight)
-  kOutOfRangeTof,   // decoded range outside [min_range_m, max_range_m]
-  kBadTemperature,  // NaN/Inf or outside [min_temperature_c, max_temperature_c]
-  kNoBeaconMap,     // an identified beacon before any beacon map arrived
-  kUnknownBeacon,   // beacon id not in the map
-  kStale,           // fired longer ago than max_age_ns before the newest firing of the robot
-  kDuplicate,       // same sequence number and firing stamp seen already
-  kBadStamp,        // fired so near the end of the clock that the arrival (fire + TOF) overflows it
-  kTimeJump,        // fired more than max_jump_ns before the newest firing, not (yet) confirmed
-};
-const char* to_string(TofRejection r);
+// The decoder's refusals are Rejection's TOF reasons (core/rejection.hpp): kNonFiniteTof (NaN or
+// Inf), kNegativeTof (<= 0: no flight), kOutOfRangeTof (decoded range outside [min_range_m,
+// max_range_m]), kBadTemperature (non-finite or outside [min_temperature_c, max_temperature_c]),
+// kNoBeaconMap (an identified beacon before any map), kUnknownBeacon, kStaleTof (fired longer than
+// max_age_ns before the robot's newest firing), kDuplicateTof (sequence number and firing stamp
+// seen already), kBadStamp (the arrival, fire + TOF, overflows the clock), kTimeJump (fired more
+// than max_jump_ns before the newest firing, not yet confirmed).
 
 struct TofDecoderConfig {
   double min_range_m = 0.1;
@@ -58,7 +53,7 @@ struct DecodedRange {
 
 struct DecodeOutcome {
   std::optional<DecodedRange> range;
-  std::optional<TofRejection> rejection;
+  std::optional<Rejection> rejection;
   bool deferred = false;  // held until the beacon map arrives (set_beacon_map decodes it)
 };
 
@@ -80,7 +75,7 @@ class TofDecoder {
 
  private:
   double range_of(const RawTofSample& tof) const;
-  DecodeOutcome reject(TofRejection r);
+  DecodeOutcome reject(Rejection r);
   DecodeOutcome decode_with_map(const std::string& robot_id, const RawTofSample& tof, double range_m);
   struct RobotState {
     StampNs newest_fire_stamp_ns = 0;

@@ -71,8 +71,8 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
   if (!r) return std::nullopt;
   r->odometry_deadlines_missed = 0;  // the bus delivers odometry again
   InputResult result = r->fusion.predict(odometry);
-  for (const auto& reason : r->fusion.take_deferred_rejections()) counts_.reject("deferred." + reason);
-  if (!result.accepted && result.rejection == "out_of_order_odometry" && clock_jumped_back(*r, odometry)) {
+  for (const auto& reason : r->fusion.take_deferred_rejections()) counts_.reject("deferred.", reason);
+  if (!result.accepted && result.rejection == Rejection::kOutOfOrderOdometry && clock_jumped_back(*r, odometry)) {
     // The robot's clock stepped back (a restarted gateway replaying, a reset clock): what the
     // estimator holds belongs to the old time line. A new one starts on the new time line
     // (restart_robot: re-localized from the beacons; the old pose is no evidence of where the
@@ -81,7 +81,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
     result = restart_robot(*r, &odometry);
   }
   if (!result.accepted) {
-    counts_.reject("odometry." + result.rejection);
+    counts_.reject("odometry.", *result.rejection);
     return std::nullopt;
   }
   r->jump_candidate_ns.reset();
@@ -127,7 +127,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_range(const std::string& robot_
   const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
   const InputResult result = r->fusion.update(range);
   if (!result.accepted) {
-    counts_.reject("range." + result.rejection);
+    counts_.reject("range.", *result.rejection);
     return std::nullopt;
   }
   counts_.accept();
@@ -143,7 +143,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_laser(const std::string& robot_
   const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
   const InputResult result = r->fusion.update_laser(scan);
   if (!result.accepted) {
-    counts_.reject("laser." + result.rejection);
+    counts_.reject("laser.", *result.rejection);
     return std::nullopt;
   }
   counts_.accept();
@@ -156,7 +156,7 @@ void LocalizerCore::on_initial_pose(const std::string& robot_id, StampNs stamp_n
   if (!r) return;
   const InputResult result = r->fusion.reset(stamp_ns, pose, covariance);
   if (!result.accepted) {
-    counts_.reject("initial_pose." + result.rejection);
+    counts_.reject("initial_pose.", *result.rejection);
     return;
   }
   counts_.accept();

@@ -1,5 +1,7 @@
 // The generic EKF: against a textbook linear Kalman filter, gating, singular innovations.
 #include "beaconloc/core/filters/ekf.hpp"
+#include "beaconloc/core/models/linear_model.hpp"
+#include "beaconloc/core/models/linear_motion.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,8 +22,8 @@ TEST(Ekf, LinearUpdateMatchesKalmanFilter) {
   r << 0.04, 0.01, 0.01, 0.09;
   const Eigen::Vector2d z(1.4, -0.3);
   const Eigen::Vector2d nu = z - h * x0;
-  const auto result = ekf.update<2>(nu, h, r, 1e9);
-  ASSERT_EQ(result.outcome, UpdateOutcome::kApplied);
+  const auto result = ekf.update(LinearModel<2, 3>(h, r), z, 1e9);
+  ASSERT_EQ(result.outcome, FilterOutcome::kApplied);
 
   // Textbook: K = P H^T S^-1, x = x + K nu, P = (I - K H) P.
   const Eigen::Matrix2d s = h * p0 * h.transpose() + r;
@@ -39,9 +41,12 @@ TEST(Ekf, PredictPropagatesCovariance) {
   Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
   f(0, 2) = 0.3;
   const Eigen::Matrix3d q = 0.01 * Eigen::Matrix3d::Identity();
-  ekf.predict(Eigen::Vector3d(1, 2, 3), f, q);
-  EXPECT_TRUE(ekf.covariance().isApprox(f * f.transpose() + q, 1e-12));
-  EXPECT_EQ(ekf.state(), Eigen::Vector3d(1, 2, 3));
+  Eigen::Matrix<double, 3, 1> b(0.1, 0.0, 1.0);
+  const auto predicted =
+      ekf.predict(LinearMotion<3, 1>(f, b, Mat<1, 1>(0.04), q), Vec<1>(2.0), 0.01);
+  ASSERT_TRUE(predicted.applied());
+  EXPECT_TRUE(ekf.covariance().isApprox(f * f.transpose() + 0.04 * b * b.transpose() + q, 1e-12));
+  EXPECT_TRUE(ekf.state().isApprox(Eigen::Vector3d(0.2, 0.0, 2.0), 1e-15));
 }
 
 TEST(Ekf, GatesOutliersAndLeavesTheStateAlone) {
@@ -49,8 +54,8 @@ TEST(Ekf, GatesOutliersAndLeavesTheStateAlone) {
   ekf.reset(Eigen::Vector3d::Zero(), 0.01 * Eigen::Matrix3d::Identity());
   const Eigen::Matrix<double, 1, 3> h(1.0, 0.0, 0.0);
   const Eigen::Matrix<double, 1, 1> r(0.01);
-  const auto result = ekf.update<1>(Eigen::Matrix<double, 1, 1>(1.0), h, r, 10.83);
-  EXPECT_EQ(result.outcome, UpdateOutcome::kGated);
+  const auto result = ekf.update(LinearModel<1, 3>(h, r), Vec<1>(1.0), 10.83);
+  EXPECT_EQ(result.outcome, FilterOutcome::kGated);
   EXPECT_NEAR(result.nis, 1.0 / 0.02, 1e-9);
   EXPECT_EQ(ekf.state(), Eigen::Vector3d::Zero());
 }
@@ -59,9 +64,8 @@ TEST(Ekf, RefusesASingularInnovationCovariance) {
   Ekf<3> ekf;
   ekf.reset(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero());
   const Eigen::Matrix<double, 1, 3> h(1.0, 0.0, 0.0);
-  const auto result =
-      ekf.update<1>(Eigen::Matrix<double, 1, 1>(0.1), h, Eigen::Matrix<double, 1, 1>(0.0), 1e9);
-  EXPECT_EQ(result.outcome, UpdateOutcome::kSingularInnovation);
+  const auto result = ekf.update(LinearModel<1, 3>(h, Mat<1, 1>(0.0)), Vec<1>(0.1), 1e9);
+  EXPECT_EQ(result.outcome, FilterOutcome::kSingularInnovation);
 }
 
 TEST(Ekf, JosephFormKeepsCovarianceSymmetricPositiveDefinite) {
@@ -69,7 +73,7 @@ TEST(Ekf, JosephFormKeepsCovarianceSymmetricPositiveDefinite) {
   ekf.reset(Eigen::Vector3d::Zero(), 1e3 * Eigen::Matrix3d::Identity());
   const Eigen::Matrix<double, 1, 3> h(0.6, 0.8, 0.0);
   for (int i = 0; i < 1000; ++i) {
-    ekf.update<1>(Eigen::Matrix<double, 1, 1>(0.0), h, Eigen::Matrix<double, 1, 1>(1e-8), 1e12);
+    ekf.update(LinearModel<1, 3>(h, Mat<1, 1>(1e-8)), Vec<1>(0.0));
   }
   const Eigen::Matrix3d p = ekf.covariance();
   EXPECT_EQ(p, p.transpose());  // exactly: consumers (ROS 2 tools) check symmetry
@@ -92,10 +96,10 @@ TEST(Ekf, PredictedAndUpdatedCovariancesAreExactlySymmetric) {
   Eigen::Matrix3d f;
   f << 1.0, 0.01, 0.37, 0.0, 1.0, -0.29, 0.013, 0.0, 1.0;
   for (int i = 0; i < 100; ++i) {
-    ekf.predict(Eigen::Vector3d::Zero(), f, 1e-3 * Eigen::Matrix3d::Identity());
+    ekf.predict(LinearMotion<3, 1>(f, Eigen::Vector3d::Zero(), Mat<1, 1>(0.0), 1e-3 * Eigen::Matrix3d::Identity()),
+                Vec<1>(0.0), 0.01);
     ASSERT_EQ(ekf.covariance(), ekf.covariance().transpose()) << i;
-    ekf.update<1>(Eigen::Matrix<double, 1, 1>(0.01), Eigen::Matrix<double, 1, 3>(0.3, -0.7, 0.2),
-                  Eigen::Matrix<double, 1, 1>(0.01), 1e12);
+    ekf.update(LinearModel<1, 3>(Eigen::Matrix<double, 1, 3>(0.3, -0.7, 0.2), Mat<1, 1>(0.01)), Vec<1>(0.01));
     ASSERT_EQ(ekf.covariance(), ekf.covariance().transpose()) << i;
   }
 }

@@ -125,7 +125,7 @@ TEST(FuzzRegression, DecoderRefusesAFiringWhoseArrivalOverflowsTheClock) {
   decoder.set_beacon_map(kMap);
   const DecodeOutcome out = decoder.decode("robot_0", tof_at(kMaxStamp - 13'427, 1));
   ASSERT_TRUE(out.rejection.has_value());
-  EXPECT_EQ(*out.rejection, TofRejection::kBadStamp);
+  EXPECT_EQ(*out.rejection, Rejection::kBadStamp);
   EXPECT_EQ(decoder.counts().rejected("bad_stamp"), 1u);
   EXPECT_EQ(decoder.counts().accepted(), 0u);
   // Just early enough, it decodes, and arrives exactly one TOF later.
@@ -148,7 +148,7 @@ TEST(FuzzRegression, DecoderJudgesFreshnessAtTheEndsOfTheClock) {
   // The whole clock behind the newest firing: far beyond max_jump_ns, a time jump to be confirmed.
   const DecodeOutcome stale = decoder.decode("robot_1", tof_at(kMinStamp + 20, 5));
   ASSERT_TRUE(stale.rejection.has_value());
-  EXPECT_EQ(*stale.rejection, TofRejection::kTimeJump);
+  EXPECT_EQ(*stale.rejection, Rejection::kTimeJump);
   EXPECT_EQ(decoder.counts().accepted(), 4u);
   EXPECT_EQ(decoder.counts().rejected_total(), 1u);
 }

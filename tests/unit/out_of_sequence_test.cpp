@@ -116,9 +116,9 @@ TEST(OutOfSequenceFusion, RefusesMeasurementsOlderThanTheHorizonOrAheadOfIt) {
   r.range_m = 2.0;
   r.variance_m2 = 1e-4;
   r.stamp_ns = 2 * kNsPerSecond - 700 * kNsPerMillisecond;
-  EXPECT_EQ(fusion.update(r).rejection, "too_late");
+  EXPECT_EQ(fusion.update(r).rejection, Rejection::kTooLate);
   r.stamp_ns = 2 * kNsPerSecond + 700 * kNsPerMillisecond;
-  EXPECT_EQ(fusion.update(r).rejection, "ahead_of_odometry");
+  EXPECT_EQ(fusion.update(r).rejection, Rejection::kAheadOfOdometry);
   r.stamp_ns = 2 * kNsPerSecond - 500 * kNsPerMillisecond;
   EXPECT_TRUE(fusion.update(r).accepted);
   EXPECT_EQ(fusion.replays(), 1u);
@@ -137,7 +137,7 @@ TEST(OutOfSequenceFusion, ARestartIsNotUndoneByMeasurementsFromBeforeIt) {
   r.range_m = 2.0;
   r.variance_m2 = 1e-4;
   r.stamp_ns = kNsPerSecond - 100 * kNsPerMillisecond;
-  EXPECT_EQ(fusion.update(r).rejection, "too_late");
+  EXPECT_EQ(fusion.update(r).rejection, Rejection::kTooLate);
   EXPECT_EQ(fusion.estimator().estimate()->pose_map_base, Pose2(1.0, 0.5, 0.2));
 }
 
@@ -153,7 +153,7 @@ TEST(OutOfSequenceFusion, APoseGivenBeforeOdometryAgesOnTheRobotsClockNotOnItsSt
       if (name == "ukf_lrf_beacons_only") config.receivers.receivers_base_m.resize(1);  // one receiver (seed 001)
       OutOfSequenceFusion fusion(EstimatorRegistry::instance().create(name, config));
       fusion.set_beacon_map(BeaconMap(sim::default_scenario().beacons));
-      EXPECT_EQ(fusion.reset(-1, Pose2(1.0, 0.5, 0.2), 1e-4 * Cov3::Identity()).rejection, "invalid_stamp");
+      EXPECT_EQ(fusion.reset(-1, Pose2(1.0, 0.5, 0.2), 1e-4 * Cov3::Identity()).rejection, Rejection::kInvalidStamp);
       ASSERT_TRUE(fusion.reset(stamp_ns, Pose2(1.0, 0.5, 0.2), 1e-4 * Cov3::Identity()).accepted) << name;
       const StampNs start_ns = 100 * kNsPerSecond;
       for (StampNs t = start_ns; t <= start_ns + 20 * kNsPerSecond; t += 10 * kNsPerMillisecond) {

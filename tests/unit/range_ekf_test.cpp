@@ -66,20 +66,20 @@ TEST(RangeEkf, RefusesBadInputWithATypedReason) {
   o.stamp_ns = 1'000'000'000;
   o.wheel_base_m = 0.33;
   EXPECT_TRUE(ekf->predict(o).accepted);
-  EXPECT_EQ(ekf->predict(o).rejection, "duplicate_odometry");
+  EXPECT_EQ(ekf->predict(o).rejection, Rejection::kDuplicateOdometry);
   o.stamp_ns -= 10'000'000;
-  EXPECT_EQ(ekf->predict(o).rejection, "out_of_order_odometry");
+  EXPECT_EQ(ekf->predict(o).rejection, Rejection::kOutOfOrderOdometry);
   o.stamp_ns = 2'000'000'000;
-  EXPECT_EQ(ekf->predict(o).rejection, "odometry_gap");
+  EXPECT_EQ(ekf->predict(o).rejection, Rejection::kOdometryGap);
   o.stamp_ns += 10'000'000;
   o.wheel_velocity_left_mps = std::nan("");
-  EXPECT_EQ(ekf->predict(o).rejection, "non_finite_odometry");
+  EXPECT_EQ(ekf->predict(o).rejection, Rejection::kNonFiniteOdometry);
   o.wheel_velocity_left_mps = 0.0;
   o.wheel_base_m = 0.0;
-  EXPECT_EQ(ekf->predict(o).rejection, "invalid_wheel_base");
+  EXPECT_EQ(ekf->predict(o).rejection, Rejection::kInvalidWheelBase);
   o.wheel_base_m = 0.33;
   o.wheel_velocity_covariance(1, 1) = -1e-6;
-  EXPECT_EQ(ekf->predict(o).rejection, "invalid_odometry_covariance");
+  EXPECT_EQ(ekf->predict(o).rejection, Rejection::kInvalidOdometryCovariance);
   o.wheel_velocity_covariance(1, 1) = 0.0;
 
   RangeMeasurement r;
@@ -90,18 +90,18 @@ TEST(RangeEkf, RefusesBadInputWithATypedReason) {
   r.variance_m2 = 1e-4;
   EXPECT_TRUE(ekf->update(r).accepted);
   r.beacon_id = 7;
-  EXPECT_EQ(ekf->update(r).rejection, "unknown_beacon");
+  EXPECT_EQ(ekf->update(r).rejection, Rejection::kUnknownBeacon);
   r.beacon_id = kBeaconUnidentified;
-  EXPECT_EQ(ekf->update(r).rejection, "unassociated_range");
+  EXPECT_EQ(ekf->update(r).rejection, Rejection::kUnassociatedRange);
   r.beacon_id = 1;
   r.receiver_id = 3;
-  EXPECT_EQ(ekf->update(r).rejection, "unknown_receiver");
+  EXPECT_EQ(ekf->update(r).rejection, Rejection::kUnknownReceiver);
   r.receiver_id = 0;
   r.range_m = std::numeric_limits<double>::infinity();
-  EXPECT_EQ(ekf->update(r).rejection, "non_finite_range");
+  EXPECT_EQ(ekf->update(r).rejection, Rejection::kNonFiniteRange);
   r.range_m = 2.1;
   r.stamp_ns = 1'000'000'000;
-  EXPECT_EQ(ekf->update(r).rejection, "stale_range");
+  EXPECT_EQ(ekf->update(r).rejection, Rejection::kStaleRange);
   EXPECT_FALSE(ekf->estimate());  // one beacon cannot give a pose
   EXPECT_EQ(ekf->status(), PoseStatus::kInitializing);
 }

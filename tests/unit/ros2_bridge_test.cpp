@@ -135,16 +135,16 @@ TEST(Ros2Bridge, MapToOdomComposesToTheEstimate) {
     o.stamp_ns = k * 10'000'000;
     ASSERT_TRUE(odom.add_wheel_odometry(o).accepted);
   }
-  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, "duplicate_odometry");  // same stamp again
+  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, Rejection::kDuplicateOdometry);  // same stamp again
   o.stamp_ns -= 5'000'000;
-  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, "out_of_order_odometry");
+  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, Rejection::kOutOfOrderOdometry);
   o.stamp_ns += 5'000'000;
   // The bus's odometry is checked as the estimators check it: an absurd speed never moves the
   // frame (it put odom -> base_link and the published twist at infinity).
   for (double v : {1e300, 1000.0}) {
     o.stamp_ns += 10'000'000;
     o.wheel_velocity_right_mps = v;
-    EXPECT_EQ(odom.add_wheel_odometry(o).rejection, "implausible_wheel_speed") << v;
+    EXPECT_EQ(odom.add_wheel_odometry(o).rejection, Rejection::kImplausibleWheelSpeed) << v;
   }
   EXPECT_EQ(*odom.latest_stamp_ns(), 1'000'000'000);
   EXPECT_NEAR(odom.v_mps(), 0.5, 1e-12);
@@ -180,7 +180,7 @@ TEST(Ros2Bridge, TheOdomFrameGoesOnAcrossAClockStepForward) {
   EXPECT_NEAR(before.x(), 0.1, 1e-9);
   const StampNs jumped_ns = 1'700'000'000'000'000'000;
   o.stamp_ns = jumped_ns;
-  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, "odometry_gap");
+  EXPECT_EQ(odom.add_wheel_odometry(o).rejection, Rejection::kOdometryGap);
   ASSERT_TRUE(odom.pose_odom_base(jumped_ns));
   EXPECT_TRUE(odom.pose_odom_base(jumped_ns)->isApprox(before, 1e-12));  // not integrated
   o.stamp_ns = jumped_ns + 10'000'000;

@@ -47,7 +47,7 @@ TEST(TofDecoder, RangeUsesTheSpeedOfSoundOfTheReportedTemperature) {
 TEST(TofDecoder, CountsEveryRejectionByReason) {
   auto d = decoder_with_map();
   std::uint64_t seq = 0;
-  auto expect_rejected = [&](RawTofSample s, TofRejection why) {
+  auto expect_rejected = [&](RawTofSample s, Rejection why) {
     const auto out = d.decode("r1", s);
     EXPECT_FALSE(out.range);
     ASSERT_TRUE(out.rejection);
@@ -55,34 +55,34 @@ TEST(TofDecoder, CountsEveryRejectionByReason) {
   };
   auto s = good(++seq);
   s.tof_s = std::nan("");
-  expect_rejected(s, TofRejection::kNonFiniteTof);
+  expect_rejected(s, Rejection::kNonFiniteTof);
   s = good(++seq);
   s.tof_s = std::numeric_limits<double>::infinity();
-  expect_rejected(s, TofRejection::kNonFiniteTof);
+  expect_rejected(s, Rejection::kNonFiniteTof);
   s = good(++seq);
   s.tof_s = -0.004;
-  expect_rejected(s, TofRejection::kNegativeTof);
+  expect_rejected(s, Rejection::kNegativeTof);
   s = good(++seq);
   s.tof_s = 0.5;  // 172 m
-  expect_rejected(s, TofRejection::kOutOfRangeTof);
+  expect_rejected(s, Rejection::kOutOfRangeTof);
   s = good(++seq);
   s.tof_s = 1e-5;  // 3.4 mm: closer than any ceiling beacon can be
-  expect_rejected(s, TofRejection::kOutOfRangeTof);
+  expect_rejected(s, Rejection::kOutOfRangeTof);
   s = good(++seq);
   s.beacon_temperature_c = std::nan("");
-  expect_rejected(s, TofRejection::kBadTemperature);
+  expect_rejected(s, Rejection::kBadTemperature);
   s = good(++seq);
   s.beacon_temperature_c = 400.0;
-  expect_rejected(s, TofRejection::kBadTemperature);
+  expect_rejected(s, Rejection::kBadTemperature);
   s = good(++seq);
   s.beacon_id = 99;
-  expect_rejected(s, TofRejection::kUnknownBeacon);
+  expect_rejected(s, Rejection::kUnknownBeacon);
 
   ASSERT_TRUE(d.decode("r1", good(++seq, 5'000'000'000)).range);      // newest firing: 5 s
-  expect_rejected(good(++seq, 4'000'000'000), TofRejection::kStale);  // 1 s older than newest
+  expect_rejected(good(++seq, 4'000'000'000), Rejection::kStaleTof);  // 1 s older than newest
   const auto dup = good(++seq, 4'900'000'000);
   ASSERT_TRUE(d.decode("r1", dup).range);  // 100 ms out of order: still useful, accepted
-  expect_rejected(dup, TofRejection::kDuplicate);
+  expect_rejected(dup, Rejection::kDuplicateTof);
 
   // Before the map: held, and refused only when it ages out (or overflows the backlog).
   TofDecoder no_map;

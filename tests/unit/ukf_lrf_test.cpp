@@ -12,7 +12,7 @@
 #include "beaconloc/core/occupancy_grid_io.hpp"
 #include "exact_ranges.hpp"
 #include "ukf_lrf/beacon_association.hpp"
-#include "ukf_lrf/laser_model.hpp"
+#include "beaconloc/core/models/laser_beam_model.hpp"
 
 namespace beaconloc::ukf_lrf {
 namespace {
@@ -139,30 +139,30 @@ TEST(UkfLrfEstimator, IsRegisteredInItsThreeModesAndRefusesWhatItCannotUse) {
   // Placed by hand: without an initial pose, no estimate, and odometry refused with a reason.
   OdometrySample o;
   o.wheel_base_m = 0.4;
-  EXPECT_EQ(fusion->predict(o).rejection, "no_initial_pose");
+  EXPECT_EQ(fusion->predict(o).rejection, Rejection::kNoInitialPose);
   EXPECT_FALSE(fusion->estimate());
 
   config.initial_pose = Pose2(1.0, 1.0, 0.0);
   auto placed = EstimatorRegistry::instance().create("ukf_lrf", config);
   LaserScanSample bad;
-  EXPECT_EQ(placed->update_laser(bad).rejection, "malformed_scan");  // no beams
+  EXPECT_EQ(placed->update_laser(bad).rejection, Rejection::kMalformedScan);  // no beams
   // A range's numbers are checked as every estimator checks them (check_range_numbers).
   RangeMeasurement bad_range;
   bad_range.variance_m2 = 1e-2;
   bad_range.range_m = std::nan("");
-  EXPECT_EQ(placed->update(bad_range).rejection, "non_finite_range");
+  EXPECT_EQ(placed->update(bad_range).rejection, Rejection::kNonFiniteRange);
   bad_range.range_m = 1e300;
-  EXPECT_EQ(placed->update(bad_range).rejection, "implausible_range");
+  EXPECT_EQ(placed->update(bad_range).rejection, Rejection::kImplausibleRange);
   bad_range.range_m = 3.0;
   bad_range.variance_m2 = 0.0;
-  EXPECT_EQ(placed->update(bad_range).rejection, "invalid_range");
+  EXPECT_EQ(placed->update(bad_range).rejection, Rejection::kInvalidRange);
   bad_range.variance_m2 = 1e-2;
   bad_range.stamp_ns = -1;
-  EXPECT_EQ(placed->update(bad_range).rejection, "invalid_stamp");
+  EXPECT_EQ(placed->update(bad_range).rejection, Rejection::kInvalidStamp);
   RangeMeasurement before_map;
   before_map.range_m = 3.0;
   before_map.variance_m2 = 1e-2;
-  EXPECT_EQ(placed->update(before_map).rejection, "no_beacon_map");
+  EXPECT_EQ(placed->update(before_map).rejection, Rejection::kNoBeaconMap);
   EXPECT_TRUE(placed->predict(o).accepted);
   ASSERT_TRUE(placed->estimate());
   EXPECT_EQ(placed->estimate()->pose_map_base, Pose2(1.0, 1.0, 0.0));
@@ -257,19 +257,19 @@ TEST(UkfLrfEstimator, HoldsAScanAheadOfTheOdometryRefusesStaleAndThinsLongScans)
   ASSERT_TRUE(drive.odometry(44'000'000, 0.0).accepted);  // reaches its stamp: fused with the motion
   EXPECT_LT(drive.ukf_->estimate()->covariance.trace(), before);
   // Older than max_measurement_age_s (0.1 s) behind the filter: refused.
-  EXPECT_EQ(drive.ukf_->update_laser(drive.scan(-100'000'000)).rejection, "stale_scan");
+  EXPECT_EQ(drive.ukf_->update_laser(drive.scan(-100'000'000)).rejection, Rejection::kStaleScan);
   // A 721-beam scan is thinned to the paper's 19 beams and still fuses.
   EXPECT_TRUE(drive.ukf_->update_laser(drive.scan(44'000'000, 721)).accepted);
   // Scans that cannot be used are refused by reason.
   LaserScanSample all_nan = drive.scan(44'000'000);
   for (auto& r : all_nan.ranges_m) r = std::nanf("");
-  EXPECT_EQ(drive.ukf_->update_laser(all_nan).rejection, "no_usable_beams");
+  EXPECT_EQ(drive.ukf_->update_laser(all_nan).rejection, Rejection::kNoUsableBeams);
   LaserScanSample unbounded = drive.scan(44'000'000);
   unbounded.range_max_m = std::numeric_limits<float>::infinity();
-  EXPECT_EQ(drive.ukf_->update_laser(unbounded).rejection, "malformed_scan");
+  EXPECT_EQ(drive.ukf_->update_laser(unbounded).rejection, Rejection::kMalformedScan);
   LaserScanSample no_increment = drive.scan(44'000'000);
   no_increment.angle_increment_rad = 0.0f;
-  EXPECT_EQ(drive.ukf_->update_laser(no_increment).rejection, "malformed_scan");
+  EXPECT_EQ(drive.ukf_->update_laser(no_increment).rejection, Rejection::kMalformedScan);
 }
 
 TEST(UkfLrfEstimator, EveryPlaceableEstimatorRestartsFromAGivenPose) {
@@ -283,11 +283,11 @@ TEST(UkfLrfEstimator, EveryPlaceableEstimatorRestartsFromAGivenPose) {
     OdometrySample o;
     o.wheel_base_m = 0.4;
     EXPECT_EQ(e->reset(0, Pose2(1.0, 2.0, std::nan("")), 0.01 * Cov3::Identity()).rejection,
-              "invalid_initial_pose")
+              Rejection::kInvalidInitialPose)
         << name;
     Cov3 not_positive = Cov3::Identity();
     not_positive(2, 2) = -1.0;
-    EXPECT_EQ(e->reset(0, Pose2(1.0, 2.0, 0.3), not_positive).rejection, "invalid_initial_pose") << name;
+    EXPECT_EQ(e->reset(0, Pose2(1.0, 2.0, 0.3), not_positive).rejection, Rejection::kInvalidInitialPose) << name;
     ASSERT_TRUE(e->reset(0, Pose2(1.0, 2.0, 0.3), 0.01 * Cov3::Identity()).accepted) << name;
     ASSERT_TRUE(e->predict(o).accepted) << name;
     ASSERT_TRUE(e->estimate()) << name;

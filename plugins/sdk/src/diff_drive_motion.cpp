@@ -12,7 +12,8 @@ DiffDrivePrediction predict_diff_drive(const Pose2& pose, double wheel_velocity_
   const double c = std::cos(heading), s = std::sin(heading);
 
   DiffDrivePrediction out;
-  out.pose = {pose.x() + delta_d * c, pose.y() + delta_d * s, wrap_angle_rad(pose.z() + delta_phi)};
+  out.step = {delta_d * c, delta_d * s, delta_phi};
+  out.pose = {pose.x() + out.step.x(), pose.y() + out.step.y(), wrap_angle_rad(pose.z() + out.step.z())};
 
   out.jacobian_pose << 1.0, 0.0, -delta_d * s,  //
       0.0, 1.0, delta_d * c,                    //

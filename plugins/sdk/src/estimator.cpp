@@ -118,20 +118,20 @@ std::string StartupWait::describe() const {
 
 InputResult check_range_numbers(const RangeMeasurement& r) {
   if (!std::isfinite(r.range_m) || !std::isfinite(r.variance_m2))
-    return InputResult::rejected("non_finite_range");
-  if (!(r.range_m > 0.0) || !(r.variance_m2 > 0.0)) return InputResult::rejected("invalid_range");
+    return InputResult::rejected(Rejection::kNonFiniteRange);
+  if (!(r.range_m > 0.0) || !(r.variance_m2 > 0.0)) return InputResult::rejected(Rejection::kInvalidRange);
   if (r.range_m > kMaxRangeM || r.variance_m2 > kMaxRangeM * kMaxRangeM)
-    return InputResult::rejected("implausible_range");
-  if (r.stamp_ns < 0) return InputResult::rejected("invalid_stamp");
+    return InputResult::rejected(Rejection::kImplausibleRange);
+  if (r.stamp_ns < 0) return InputResult::rejected(Rejection::kInvalidStamp);
   return InputResult::ok();
 }
 
 InputResult check_range(const RangeMeasurement& r, const BeaconMap& map, std::size_t receiver_count) {
   if (InputResult numbers = check_range_numbers(r); !numbers.accepted) return numbers;
-  if (r.beacon_id == kBeaconUnidentified) return InputResult::rejected("unassociated_range");
-  if (map.empty()) return InputResult::rejected("no_beacon_map");
-  if (!map.find(r.beacon_id)) return InputResult::rejected("unknown_beacon");
-  if (r.receiver_id >= receiver_count) return InputResult::rejected("unknown_receiver");
+  if (r.beacon_id == kBeaconUnidentified) return InputResult::rejected(Rejection::kUnassociatedRange);
+  if (map.empty()) return InputResult::rejected(Rejection::kNoBeaconMap);
+  if (!map.find(r.beacon_id)) return InputResult::rejected(Rejection::kUnknownBeacon);
+  if (r.receiver_id >= receiver_count) return InputResult::rejected(Rejection::kUnknownReceiver);
   return InputResult::ok();
 }
 
@@ -170,13 +170,13 @@ std::string EstimatorRegistry::description(const std::string& name) const {
 InputResult check_initial_pose(const Pose2& pose, const Cov3& c) {
   if (!pose.allFinite() || !c.allFinite() || !c.isApprox(c.transpose(), 1e-9) ||
       Eigen::LLT<Cov3>(c).info() != Eigen::Success) {
-    return InputResult::rejected("invalid_initial_pose");
+    return InputResult::rejected(Rejection::kInvalidInitialPose);
   }
   // Beyond any site (core/limits.hpp), or a standard deviation beyond it:
   // no place to start from.
   if (pose.head<2>().cwiseAbs().maxCoeff() > kMaxMapCoordinateM ||
       c.diagonal().maxCoeff() > kMaxMapCoordinateM * kMaxMapCoordinateM) {
-    return InputResult::rejected("implausible_initial_pose");
+    return InputResult::rejected(Rejection::kImplausibleInitialPose);
   }
   return InputResult::ok();
 }

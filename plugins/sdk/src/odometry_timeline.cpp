@@ -19,16 +19,16 @@ bool valid_covariance(const Eigen::Matrix2d& c) {
 InputResult check_odometry_numbers(const OdometrySample& o) {
   const bool finite = std::isfinite(o.wheel_velocity_right_mps) && std::isfinite(o.wheel_velocity_left_mps) &&
                       std::isfinite(o.wheel_base_m) && o.wheel_velocity_covariance.allFinite();
-  if (!finite) return InputResult::rejected("non_finite_odometry");
-  if (o.stamp_ns < 0) return InputResult::rejected("invalid_stamp");
-  if (!(o.wheel_base_m > 0.0)) return InputResult::rejected("invalid_wheel_base");
-  if (o.wheel_base_m > kMaxWheelBaseM) return InputResult::rejected("implausible_wheel_base");
+  if (!finite) return InputResult::rejected(Rejection::kNonFiniteOdometry);
+  if (o.stamp_ns < 0) return InputResult::rejected(Rejection::kInvalidStamp);
+  if (!(o.wheel_base_m > 0.0)) return InputResult::rejected(Rejection::kInvalidWheelBase);
+  if (o.wheel_base_m > kMaxWheelBaseM) return InputResult::rejected(Rejection::kImplausibleWheelBase);
   if (std::abs(o.wheel_velocity_right_mps) > kMaxWheelSpeedMps ||
       std::abs(o.wheel_velocity_left_mps) > kMaxWheelSpeedMps) {
     // Integrated, 1e300 m/s puts the pose at 1e298 m; 1000 m/s jumps it 10 m a sample.
-    return InputResult::rejected("implausible_wheel_speed");
+    return InputResult::rejected(Rejection::kImplausibleWheelSpeed);
   }
-  if (!valid_covariance(o.wheel_velocity_covariance)) return InputResult::rejected("invalid_odometry_covariance");
+  if (!valid_covariance(o.wheel_velocity_covariance)) return InputResult::rejected(Rejection::kInvalidOdometryCovariance);
   return InputResult::ok();
 }
 
@@ -41,14 +41,14 @@ OdometryTimeline::Step OdometryTimeline::advance(const OdometrySample& o) {
     last_stamp_ns_ = o.stamp_ns;  // the anchor of the time line
   } else if (o.stamp_ns <= *last_stamp_ns_) {
     step.result =
-        InputResult::rejected(o.stamp_ns == *last_stamp_ns_ ? "duplicate_odometry" : "out_of_order_odometry");
+        InputResult::rejected(o.stamp_ns == *last_stamp_ns_ ? Rejection::kDuplicateOdometry : Rejection::kOutOfOrderOdometry);
   } else {
     step.dt_s = ns_to_s(o.stamp_ns - *last_stamp_ns_);
     last_stamp_ns_ = o.stamp_ns;
     if (step.dt_s > max_gap_s_) {
       // Integrating the velocities over the whole gap would invent motion: the sample
       // re-anchors the time line and the gap is reported.
-      step.result = InputResult::rejected("odometry_gap");
+      step.result = InputResult::rejected(Rejection::kOdometryGap);
     } else {
       step.integrate = true;
     }

@@ -57,7 +57,7 @@ InputResult OutOfSequenceFusion::predict(const OdometrySample& odometry) {
   // Only a sample that moved the estimator's time line is kept: an accepted one, or an
   // odometry_gap, which re-anchors it (a replay must do the same). A refused sample changed
   // nothing (non-finite values, a duplicate, out of order) and must not move the horizon.
-  if (!result.accepted && result.rejection != "odometry_gap") return result;
+  if (!result.accepted && result.rejection != Rejection::kOdometryGap) return result;
   if (newest_odometry_ns_ && odometry.stamp_ns <= *newest_odometry_ns_) return result;
   newest_odometry_ns_ = odometry.stamp_ns;
   if (placed_before_odometry_) {
@@ -97,12 +97,12 @@ InputResult OutOfSequenceFusion::measurement(Event event) {
   }
   if (event.stamp_ns < base_stamp_ns_ ||
       older_than(event.stamp_ns, *newest_odometry_ns_, options_.horizon_ns)) {
-    return InputResult::rejected("too_late");
+    return InputResult::rejected(Rejection::kTooLate);
   }
   // A stamp further ahead of the odometry than the horizon is a clock fault (a time jump), not a
   // measurement the odometry will catch up with.
   if (older_than(*newest_odometry_ns_, event.stamp_ns, options_.horizon_ns)) {
-    return InputResult::rejected("ahead_of_odometry");
+    return InputResult::rejected(Rejection::kAheadOfOdometry);
   }
   // After every event stamped at or before it (odometry of the same stamp first). Searched from
   // the newest: a measurement slightly ahead of the odometry stays where it was processed.
@@ -143,7 +143,7 @@ InputResult OutOfSequenceFusion::measurement(Event event) {
 }
 
 InputResult OutOfSequenceFusion::reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) {
-  if (stamp_ns < 0) return InputResult::rejected("invalid_stamp");
+  if (stamp_ns < 0) return InputResult::rejected(Rejection::kInvalidStamp);
   const InputResult result = estimator_->reset(stamp_ns, pose_map_base, covariance);
   collect_outputs();
   if (!result.accepted) return result;
@@ -179,8 +179,8 @@ std::vector<Estimator::Association> OutOfSequenceFusion::take_associations() {
   return out;
 }
 
-std::vector<std::string> OutOfSequenceFusion::take_deferred_rejections() {
-  std::vector<std::string> out;
+std::vector<Rejection> OutOfSequenceFusion::take_deferred_rejections() {
+  std::vector<Rejection> out;
   out.swap(deferred_rejections_);
   return out;
 }

@@ -6,6 +6,8 @@
 #include "beaconloc/core/estimator_parameters.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/models/diff_drive_motion.hpp"
+#include "beaconloc/core/models/linear_model.hpp"
+#include "beaconloc/core/models/pose_observation_model.hpp"
 
 namespace beaconloc::duhl {
 namespace {
@@ -73,8 +75,10 @@ DuhlParameters DuhlParameters::from(const EstimatorConfig& c) {
   return p;
 }
 
-Duhl::Duhl(const EstimatorConfig& config)
-    : ring_(ring_of(config)), params_(DuhlParameters::from(config)), timeline_(params_.max_odometry_gap_s) {
+Duhl::Duhl(const EstimatorConfig& config) : Duhl(config, DuhlParameters::from(config)) {}
+
+Duhl::Duhl(const EstimatorConfig& config, const DuhlParameters& params)
+    : EstimatorBase(params.max_odometry_gap_s), ring_(ring_of(config)), params_(params) {
   if (!three_on_a_circle(config)) {
     throw std::invalid_argument(
         "duhl needs three receivers on a circle at 0, 120, 240 degrees (seed 000 eq. 1)");
@@ -82,17 +86,18 @@ Duhl::Duhl(const EstimatorConfig& config)
 }
 
 InputResult Duhl::predict(const OdometrySample& o) {
-  const OdometryTimeline::Step step = timeline_.advance(o);
+  const OdometryTimeline::Step step = advance(o);
   if (!step.integrate) return step.result;
   const Eigen::Matrix2d u =
       o.wheel_velocity_covariance + params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity();
-  if (initialized_) {  // eq. 14, 16
-    const DiffDrivePrediction p = predict_diff_drive(ekf_.state(), o.wheel_velocity_right_mps,
-                                                     o.wheel_velocity_left_mps, o.wheel_base_m, step.dt_s);
-    ekf_.predict(p.pose, p.jacobian_pose, p.jacobian_wheels * u * p.jacobian_wheels.transpose());
+  if (has_pose()) {  // eq. 14, 16
+    const PredictResult predicted = ekf_.predict(
+        DiffDriveMotion(o.wheel_base_m, u), Eigen::Vector2d(o.wheel_velocity_right_mps, o.wheel_velocity_left_mps),
+        step.dt_s);
+    if (!predicted.applied()) return InputResult::refused(predicted.outcome);
   }
   for (auto it = available_.begin(); it != available_.end();) {
-    const double z = map_.find(it->first)->position_map_m.z() - ring_.height_m;
+    const double z = map().find(it->first)->position_map_m.z() - ring_.height_m;
     const DistancePrediction p =
         predict_distances(it->second.q, z, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
                           o.wheel_base_m, step.dt_s, ring_);
@@ -113,7 +118,7 @@ InputResult Duhl::predict(const OdometrySample& o) {
 }
 
 InputResult Duhl::update(const RangeMeasurement& r) {
-  if (const InputResult checked = check_range(r, map_, 3); !checked.accepted) return checked;
+  if (const InputResult checked = check_range(r, map(), 3); !checked.accepted) return checked;
   auto it = available_.find(r.beacon_id);
   if (it != available_.end() && params_.distance_innovation_gate > 0.0) {
     // Not in the paper: an estimate its own measurement contradicts (at 1.02 m/s a turn can
@@ -136,9 +141,8 @@ InputResult Duhl::update(const RangeMeasurement& r) {
   Eigen::Matrix<double, 1, 3> h = Eigen::Matrix<double, 1, 3>::Zero();
   h(r.receiver_id) = 1.0;
   const UpdateResult result =
-      q_filter.update<1>(Eigen::Matrix<double, 1, 1>(r.range_m - it->second.q(r.receiver_id)), h,
-                         Eigen::Matrix<double, 1, 1>(r.variance_m2), 1e12);
-  if (result.outcome != UpdateOutcome::kApplied) return InputResult::rejected("singular_innovation");
+      q_filter.update(LinearModel<1, 3>(h, Mat<1, 1>(r.variance_m2)), Vec<1>(r.range_m));
+  if (!result.applied()) return InputResult::refused(result.outcome);
   it->second.q = q_filter.state();
   it->second.covariance = q_filter.covariance();
   // This receiver's distance now carries the measurement's own variance (eq. 27), and no longer
@@ -153,9 +157,9 @@ InputResult Duhl::update(const RangeMeasurement& r) {
 
 Duhl::TxEstimate Duhl::new_tx_estimate(const RangeMeasurement& r) const {
   TxEstimate fresh;
-  if (initialized_) {  // eq. 28-29, then eq. 30
+  if (has_pose()) {  // eq. 28-29, then eq. 30
     const DistanceInit init =
-        initial_distances(ekf_.state(), ekf_.covariance(), map_.find(r.beacon_id)->position_map_m, ring_);
+        initial_distances(ekf_.state(), ekf_.covariance(), map().find(r.beacon_id)->position_map_m, ring_);
     fresh.q = init.q;
     fresh.covariance = init.covariance;
   } else {
@@ -194,54 +198,40 @@ void Duhl::observe() {
   if (available_.size() < kMinTxs) return;
   std::vector<TxDistances> txs;
   txs.reserve(available_.size());
-  for (const auto& [id, e] : available_) txs.push_back({map_.find(id)->position_map_m, e.q});
+  for (const auto& [id, e] : available_) txs.push_back({map().find(id)->position_map_m, e.q});
   const UhlSolution z = solve_uhl(txs, params_.uhl);
   if (!z.ok) {
     uhl_failure_ = z.failure;
     return;
   }
   const Cov3 r = observation_covariance(txs, z);
-  const StampNs now = *timeline_.last_stamp_ns();
-  if (!initialized_) {
+  const StampNs now = *now_ns();
+  if (!has_pose()) {
     ekf_.reset(z.pose, r);
-    initialized_ = true;
-    last_correction_stamp_ns_ = now;
+    start(now);
     return;
   }
   // Eq. 17-20 with J_h,x = I.
-  const Eigen::Vector3d innovation = pose_difference(z.pose, ekf_.state());
-  const UpdateResult result =
-      ekf_.update<3>(innovation, Eigen::Matrix3d::Identity(), r, params_.observation_nis_gate);
-  if (result.outcome == UpdateOutcome::kApplied) {
-    ekf_.mutable_state().z() = wrap_angle_rad(ekf_.state().z());
-    last_correction_stamp_ns_ = now;
+  const UpdateResult result = ekf_.update(PoseObservationModel(r), z.pose, params_.observation_nis_gate);
+  if (result.applied()) {
+    corrected(now);
     consecutive_gated_ = 0;
   } else if (params_.reinitialize_after_gated > 0 &&
              ++consecutive_gated_ >= params_.reinitialize_after_gated) {
     ekf_.reset(z.pose, r);  // the UHL and the filter disagree for too long: trust the beacons
-    last_correction_stamp_ns_ = now;
+    corrected(now);
     consecutive_gated_ = 0;
   }
 }
 
-InputResult Duhl::reset(StampNs stamp_ns, const Pose2& pose, const Cov3& covariance) {
-  if (const InputResult checked = check_initial_pose(pose, covariance); !checked.accepted) return checked;
+bool Duhl::place(const Pose2& pose, const Cov3& covariance) {
   ekf_.reset(pose, covariance);  // the distance estimates stay: they come from the measurements
-  initialized_ = true;
   consecutive_gated_ = 0;
-  last_correction_stamp_ns_ = timeline_.last_stamp_ns().value_or(stamp_ns);
-  return InputResult::ok();
+  return true;
 }
 
-std::optional<PoseEstimate> Duhl::estimate() const {
-  if (!initialized_ || !timeline_.last_stamp_ns()) return std::nullopt;
-  return PoseEstimate{*timeline_.last_stamp_ns(), ekf_.state(), ekf_.covariance(), status()};
-}
-
-std::optional<StartupWait> Duhl::startup_wait() const {
-  if (estimate()) return std::nullopt;
-  if (map_.empty()) return StartupWait{StartupCondition::kNoBeaconMap, 0.0, 0.0, {}};
-  if (!timeline_.last_stamp_ns()) return StartupWait{StartupCondition::kNoOdometry, 0.0, 0.0, {}};
+StartupWait Duhl::waiting_for() const {
+  if (!now_ns()) return StartupWait{StartupCondition::kNoOdometry, 0.0, 0.0, {}};
   if (available_.size() < kMinTxs) {
     return StartupWait{StartupCondition::kTooFewBeacons,
                        static_cast<double>(available_.size()),
@@ -249,12 +239,6 @@ std::optional<StartupWait> Duhl::startup_wait() const {
                        {}};
   }
   return StartupWait{StartupCondition::kFixFailed, 0.0, 0.0, "uhl: " + uhl_failure_};
-}
-
-PoseStatus Duhl::status() const {
-  if (!initialized_) return PoseStatus::kInitializing;
-  return staleness_.classify(timeline_.last_stamp_ns().value_or(last_correction_stamp_ns_),
-                             last_correction_stamp_ns_);
 }
 
 UhlOptions UhlLast2::options_from(const EstimatorConfig& config) {
@@ -265,7 +249,7 @@ UhlOptions UhlLast2::options_from(const EstimatorConfig& config) {
 }
 
 UhlLast2::UhlLast2(const EstimatorConfig& config)
-    : ring_(ring_of(config)), uhl_(options_from(config)), timeline_(0.2) {
+    : EstimatorBase(0.2), ring_(ring_of(config)), uhl_(options_from(config)) {
   if (!three_on_a_circle(config)) {
     throw std::invalid_argument(
         "uhl_last2 needs three receivers on a circle at 0, 120, 240 degrees (seed 000 eq. 1)");
@@ -273,7 +257,7 @@ UhlLast2::UhlLast2(const EstimatorConfig& config)
 }
 
 InputResult UhlLast2::predict(const OdometrySample& o) {
-  const OdometryTimeline::Step step = timeline_.advance(o);
+  const OdometryTimeline::Step step = advance(o);
   if (!step.result.accepted) return step.result;
   if (!pending_) return InputResult::ok();
   pending_ = false;
@@ -282,7 +266,7 @@ InputResult UhlLast2::predict(const OdometrySample& o) {
   std::vector<DistanceCov> covariances;
   for (auto it = firings_.rbegin(); it != firings_.rend() && txs.size() < kMinTxs; ++it) {
     if (!(it->heard[0] && it->heard[1] && it->heard[2])) continue;
-    txs.push_back({map_.find(it->beacon_id)->position_map_m, it->d});
+    txs.push_back({map().find(it->beacon_id)->position_map_m, it->d});
     covariances.push_back(it->variance_m2 * DistanceCov::Identity());
   }
   heard_by_all_ = txs.size();
@@ -292,15 +276,13 @@ InputResult UhlLast2::predict(const OdometrySample& o) {
     uhl_failure_ = z.failure;
     return InputResult::ok();
   }
-  last_ = PoseEstimate{o.stamp_ns, z.pose,
-                       uhl_observation_covariance(txs, z, covariances, uhl_) + 1e-9 * Cov3::Identity(),
-                       PoseStatus::kOk};
-  last_solution_stamp_ns_ = o.stamp_ns;
+  last_ = {z.pose, uhl_observation_covariance(txs, z, covariances, uhl_) + 1e-9 * Cov3::Identity()};
+  start(o.stamp_ns);
   return InputResult::ok();
 }
 
 InputResult UhlLast2::update(const RangeMeasurement& r) {
-  if (const InputResult checked = check_range(r, map_, 3); !checked.accepted) return checked;
+  if (const InputResult checked = check_range(r, map(), 3); !checked.accepted) return checked;
   // A new firing when this Tx is not the newest, or this receiver was already heard from it.
   if (firings_.empty() || firings_.back().beacon_id != r.beacon_id || firings_.back().heard[r.receiver_id]) {
     firings_.erase(std::remove_if(firings_.begin(), firings_.end(),
@@ -316,29 +298,13 @@ InputResult UhlLast2::update(const RangeMeasurement& r) {
   return InputResult::ok();
 }
 
-std::optional<PoseEstimate> UhlLast2::estimate() const {
-  if (!last_ || !timeline_.last_stamp_ns()) return std::nullopt;
-  PoseEstimate e = *last_;  // the last UHL pose, held until the next
-  e.stamp_ns = *timeline_.last_stamp_ns();
-  e.status = status();
-  return e;
-}
-
-std::optional<StartupWait> UhlLast2::startup_wait() const {
-  if (estimate()) return std::nullopt;
-  if (map_.empty()) return StartupWait{StartupCondition::kNoBeaconMap, 0.0, 0.0, {}};
-  if (!timeline_.last_stamp_ns()) return StartupWait{StartupCondition::kNoOdometry, 0.0, 0.0, {}};
+StartupWait UhlLast2::waiting_for() const {
+  if (!now_ns()) return StartupWait{StartupCondition::kNoOdometry, 0.0, 0.0, {}};
   if (heard_by_all_ < kMinTxs) {
     return StartupWait{StartupCondition::kTooFewBeacons, static_cast<double>(heard_by_all_),
                        static_cast<double>(kMinTxs), "heard by all three receivers"};
   }
   return StartupWait{StartupCondition::kFixFailed, 0.0, 0.0, "uhl: " + uhl_failure_};
-}
-
-PoseStatus UhlLast2::status() const {
-  if (!last_) return PoseStatus::kInitializing;
-  return staleness_.classify(timeline_.last_stamp_ns().value_or(last_solution_stamp_ns_),
-                             last_solution_stamp_ns_);
 }
 
 namespace {

@@ -7,9 +7,8 @@
 #include <optional>
 
 #include "beaconloc/core/chi_square.hpp"
-#include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/estimator_base.hpp"
 #include "beaconloc/core/filters/ekf.hpp"
-#include "beaconloc/core/odometry_timeline.hpp"
 #include "distance_prediction.hpp"
 #include "uhl.hpp"
 
@@ -47,23 +46,22 @@ struct DuhlParameters {
   static DuhlParameters from(const EstimatorConfig& config);
 };
 
-class Duhl final : public Estimator {
+class Duhl final : public EstimatorBase {
  public:
   explicit Duhl(const EstimatorConfig& config);
   std::string name() const override { return "duhl"; }
-  void set_beacon_map(const BeaconMap& map) override { map_ = map; }
   InputResult predict(const OdometrySample& odometry) override;
   InputResult update(const RangeMeasurement& range) override;
-  InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
-  std::optional<PoseEstimate> estimate() const override;
-  PoseStatus status() const override;
-  std::optional<StartupWait> startup_wait() const override;
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<Duhl>(*this); }
   std::size_t available_txs() const { return available_.size(); }
   // Tx estimates discarded because their own measurement contradicted them (distance_innovation_gate).
   std::uint64_t contradicted_txs() const { return contradicted_txs_; }
 
  private:
+  Duhl(const EstimatorConfig& config, const DuhlParameters& params);
+  PoseBelief pose_belief() const override { return {ekf_.state(), ekf_.covariance()}; }
+  StartupWait waiting_for() const override;
+  bool place(const Pose2& pose_map_base, const Cov3& covariance) override;
   struct TxEstimate {
     Distances q;
     DistanceCov covariance;  // Q^i (eq. 24, 26)
@@ -77,33 +75,26 @@ class Duhl final : public Estimator {
 
   ReceiverRing ring_;
   DuhlParameters params_;
-  StalenessPolicy staleness_;
-  BeaconMap map_;
-  OdometryTimeline timeline_;
-  Ekf<3> ekf_;
-  bool initialized_ = false;
+  Ekf<3> ekf_{pose_space()};
   std::map<std::uint32_t, TxEstimate> available_;  // T_A and Q (eq. 30)
   bool pending_observation_ = false;
-  StampNs last_correction_stamp_ns_ = 0;
   int consecutive_gated_ = 0;
   std::uint64_t contradicted_txs_ = 0;
   std::string uhl_failure_;  // why the last UHL solve failed
 };
 
 // The paper's baseline: UHL on the distances last measured from the last two Txs, no odometry.
-class UhlLast2 final : public Estimator {
+class UhlLast2 final : public EstimatorBase {
  public:
   explicit UhlLast2(const EstimatorConfig& config);
   std::string name() const override { return "uhl_last2"; }
-  void set_beacon_map(const BeaconMap& map) override { map_ = map; }
   InputResult predict(const OdometrySample& odometry) override;
   InputResult update(const RangeMeasurement& range) override;
-  std::optional<PoseEstimate> estimate() const override;
-  PoseStatus status() const override;
-  std::optional<StartupWait> startup_wait() const override;
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<UhlLast2>(*this); }
 
  private:
+  PoseBelief pose_belief() const override { return last_; }
+  StartupWait waiting_for() const override;
   static UhlOptions options_from(const EstimatorConfig& config);
   struct Firing {
     std::uint32_t beacon_id;
@@ -113,13 +104,9 @@ class UhlLast2 final : public Estimator {
   };
   ReceiverRing ring_;
   UhlOptions uhl_;
-  StalenessPolicy staleness_;
-  BeaconMap map_;
-  OdometryTimeline timeline_;
   std::vector<Firing> firings_;  // the latest firing of each of the last Txs heard, newest last
   bool pending_ = false;
-  std::optional<PoseEstimate> last_;
-  StampNs last_solution_stamp_ns_ = 0;
+  PoseBelief last_{Pose2::Zero(), Cov3::Identity()};  // the last UHL pose, held until the next
   std::size_t heard_by_all_ = 0;  // of the last Txs, those heard by all three receivers (at most kMinTxs)
   std::string uhl_failure_;       // why the last UHL solve failed
 };

@@ -54,36 +54,37 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
   return p;
 }
 
-RangeEkf::RangeEkf(const EstimatorConfig& config)
-    : receivers_(config.receivers),
-      params_(RangeEkfParameters::from(config)),
-      timeline_(params_.max_odometry_gap_s) {
+RangeEkf::RangeEkf(const EstimatorConfig& config) : RangeEkf(config, RangeEkfParameters::from(config)) {}
+
+RangeEkf::RangeEkf(const EstimatorConfig& config, const RangeEkfParameters& params)
+    : EstimatorBase(params.max_odometry_gap_s), receivers_(config.receivers), params_(params) {
   waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(params_.init_min_beacons), {}};
 }
 
 InputResult RangeEkf::predict(const OdometrySample& o) {
-  const OdometryTimeline::Step step = timeline_.advance(o);
+  const OdometryTimeline::Step step = advance(o);
   if (!step.integrate) return step.result;
   const double dt_s = step.dt_s;
   odom_pose_ = predict_diff_drive(odom_pose_, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
                                   o.wheel_base_m, dt_s)
                    .pose;
-  if (initialized_) {
-    const DiffDrivePrediction p = predict_diff_drive(ekf_.state(), o.wheel_velocity_right_mps,
-                                                     o.wheel_velocity_left_mps, o.wheel_base_m, dt_s);
-    const Eigen::Matrix2d u = o.wheel_velocity_covariance +
-                              params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity();
-    // Eq. 16: P = J_f,x P J_f,x^T + J_f,u U J_f,u^T.
-    ekf_.predict(p.pose, p.jacobian_pose, p.jacobian_wheels * u * p.jacobian_wheels.transpose());
+  if (has_pose()) {
+    const DiffDriveMotion motion(o.wheel_base_m,
+                                 o.wheel_velocity_covariance +
+                                     params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity());
+    // Eq. 14, 16: P = J_f,x P J_f,x^T + J_f,u U J_f,u^T.
+    const PredictResult predicted = ekf_.predict(
+        motion, Eigen::Vector2d(o.wheel_velocity_right_mps, o.wheel_velocity_left_mps), dt_s);
+    if (!predicted.applied()) return InputResult::refused(predicted.outcome);
   }
   return InputResult::ok();
 }
 
 InputResult RangeEkf::update(const RangeMeasurement& r) {
-  if (const InputResult checked = check_range(r, map_, receivers_.size()); !checked.accepted) return checked;
-  if (timeline_.last_stamp_ns() &&
-      r.stamp_ns < *timeline_.last_stamp_ns() - s_to_ns(params_.max_range_age_s)) {
-    return InputResult::rejected("stale_range");
+  if (const InputResult checked = check_range(r, map(), receivers_.size()); !checked.accepted) return checked;
+  if (now_ns() &&
+      r.stamp_ns < *now_ns() - s_to_ns(params_.max_range_age_s)) {
+    return InputResult::rejected(Rejection::kStaleRange);
   }
 
   // Every good range joins the window a global fix is computed from.
@@ -92,7 +93,7 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
                               window_.size() > kMaxWindowRanges)) {
     window_.pop_front();
   }
-  if (!initialized_) {
+  if (!has_pose()) {
     try_initialize();
     return InputResult::ok();
   }
@@ -103,33 +104,30 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
 // order, the pulse arrived within one odometry period of it (<= 10 ms, 3.4 mm at 0.34 m/s). The
 // localizer pushes in stamp order however late a range arrives (core/out_of_sequence_fusion).
 InputResult RangeEkf::fuse(const RangeMeasurement& r) {
-  const Beacon& beacon = *map_.find(r.beacon_id);
-  const RangePrediction p = predict_range(ekf_.state(), receivers_.receivers_base_m[r.receiver_id],
-                                          receivers_.receiver_height_m, beacon.position_map_m);
-  const Eigen::Matrix<double, 1, 1> innovation(r.range_m - p.range_m);
-  const Eigen::Matrix<double, 1, 1> noise(r.variance_m2);
-  const UpdateResult result = ekf_.update<1>(innovation, p.jacobian_pose, noise, params_.nis_gate);
+  const Beacon& beacon = *map().find(r.beacon_id);
+  const RangeModel model(receivers_.receivers_base_m[r.receiver_id], receivers_.receiver_height_m,
+                         beacon.position_map_m, r.variance_m2);
+  const UpdateResult result = ekf_.update(model, RangeModel::Vector(r.range_m), params_.nis_gate);
   switch (result.outcome) {
-    case UpdateOutcome::kApplied:
-      ekf_.mutable_state().z() = wrap_angle_rad(ekf_.state().z());
+    case FilterOutcome::kApplied:
       consecutive_gated_ = 0;
-      last_correction_stamp_ns_ = std::max(r.stamp_ns, timeline_.last_stamp_ns().value_or(r.stamp_ns));
+      corrected(std::max(r.stamp_ns, now_ns().value_or(r.stamp_ns)));
       watch_divergence({false, result.nis});
       return InputResult::ok();
-    case UpdateOutcome::kSingularInnovation:
-      return InputResult::rejected("singular_innovation");
-    case UpdateOutcome::kGated:
+    case FilterOutcome::kGated:
       break;
+    default:
+      return InputResult::refused(result.outcome);
   }
   ++consecutive_gated_;
   watch_divergence({true, result.nis});
-  if (initialized_ && consecutive_gated_ >= params_.reinitialize_after_gated) {
+  if (has_pose() && consecutive_gated_ >= params_.reinitialize_after_gated) {
     // The filter no longer agrees with the beacons: start again from a global fix.
-    initialized_ = false;
+    forget_pose();
     consecutive_gated_ = 0;
     try_initialize();
   }
-  return InputResult::rejected("gated_nis");
+  return InputResult::rejected(Rejection::kGatedNis);
 }
 
 // The recent ranges judge the pose: a run of gated ranges, or applied ones fitting worse than
@@ -152,10 +150,10 @@ void RangeEkf::watch_divergence(const RangeOutcome& outcome) {
   suspect_ = gated >= params_.divergence_gated_ranges ||
              (full && applied > 0 && applied_nis > chi_square_quantile_999(applied));
   if (!suspect_) return;
-  const StampNs now_ns = window_.back().range.stamp_ns;
-  if (!attempt_due(now_ns)) return;
+  const StampNs newest_range_ns = window_.back().range.stamp_ns;
+  if (!attempt_due(newest_range_ns)) return;
   const WindowFix fix = window_fix();
-  if (fix.solved) last_init_attempt_ns_ = now_ns;
+  if (fix.solved) last_init_attempt_ns_ = newest_range_ns;
   if (!fix.ok) return;  // nothing to settle it with yet: the pose stays degraded
   // Contradicted: the fix lies outside the pose's uncertainty and explains the window's ranges
   // better by the margin (echoes capped, so that they weigh on both alike).
@@ -167,44 +165,48 @@ void RangeEkf::watch_divergence(const RangeOutcome& outcome) {
   const double margin = kPoseMarginChiSquare * fix.variance_factor;
   if (d.dot((ekf_.covariance() + fix.covariance).ldlt().solve(d)) > kChiSquare999ThreeDof &&
       pose_cost - fix_cost > margin) {
-    start_from(fix.pose, fix.covariance, std::max(now_ns, timeline_.last_stamp_ns().value_or(now_ns)));
+    start_from(fix.pose, fix.covariance, std::max(newest_range_ns, now_ns().value_or(newest_range_ns)));
     ++divergence_reinitializations_;
   }
   recent_.clear();  // explained: by a wrong pose now replaced, or by outliers the fix agrees on
   suspect_ = false;
 }
 
-bool RangeEkf::attempt_due(StampNs now_ns) const {
+bool RangeEkf::attempt_due(StampNs newest_range_ns) const {
   // The multi-start solve costs ~1 ms: not more often than init_retry_interval_s of data time.
-  return !last_init_attempt_ns_ || now_ns - *last_init_attempt_ns_ >= s_to_ns(params_.init_retry_interval_s);
+  return !last_init_attempt_ns_ || newest_range_ns - *last_init_attempt_ns_ >= s_to_ns(params_.init_retry_interval_s);
 }
 
 void RangeEkf::try_initialize() {
-  const StampNs now_ns = window_.back().range.stamp_ns;
-  if (!attempt_due(now_ns)) return;
+  const StampNs newest_range_ns = window_.back().range.stamp_ns;
+  if (!attempt_due(newest_range_ns)) return;
   const WindowFix fix = window_fix();
-  if (fix.solved) last_init_attempt_ns_ = now_ns;
+  if (fix.solved) last_init_attempt_ns_ = newest_range_ns;
   if (!fix.ok) {
     waiting_for_ = fix.why_not;
     return;
   }
-  start_from(fix.pose, fix.covariance, std::max(now_ns, timeline_.last_stamp_ns().value_or(now_ns)));
+  start_from(fix.pose, fix.covariance, std::max(newest_range_ns, now_ns().value_or(newest_range_ns)));
 }
 
 void RangeEkf::start_from(const Pose2& pose, const Cov3& covariance, StampNs correction_stamp_ns) {
-  ekf_.reset(pose, covariance);
-  initialized_ = true;
+  place(pose, covariance);
+  start(correction_stamp_ns);
+}
+
+bool RangeEkf::place(const Pose2& pose, const Cov3& covariance) {
+  ekf_.reset(pose, covariance);  // a checked pose (check_initial_pose) or a global fix
   consecutive_gated_ = 0;
   recent_.clear();
   suspect_ = false;
-  last_correction_stamp_ns_ = correction_stamp_ns;
+  return true;
 }
 
 RangeEkf::WindowFix RangeEkf::window_fix() const {
   WindowFix out;
   std::set<std::uint32_t> beacons;
   for (const auto& b : window_) {
-    if (map_.find(b.range.beacon_id)) beacons.insert(b.range.beacon_id);
+    if (map().find(b.range.beacon_id)) beacons.insert(b.range.beacon_id);
   }
   if (static_cast<int>(beacons.size()) < params_.init_min_beacons) {
     out.why_not = {StartupCondition::kTooFewBeacons,
@@ -238,7 +240,7 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
   std::vector<RangeObservation> observations;
   for (std::size_t k = 0; k < window_.size(); ++k) {
     const BufferedRange& b = window_[k];
-    const Beacon* beacon = map_.find(b.range.beacon_id);
+    const Beacon* beacon = map().find(b.range.beacon_id);
     if (echo[k] || !beacon) continue;
     // Where the receiver was, in the frame of the robot now (dead-reckoned odometry).
     const Pose2 then_in_now = between(odom_pose_, b.odom_pose_at_range);
@@ -301,36 +303,6 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
   // The fix ignores the correlation the shared odometry introduces: inflate it.
   out.covariance = 4.0 * fix.covariance + Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal().toDenseMatrix();
   return out;
-}
-
-InputResult RangeEkf::reset(StampNs stamp_ns, const Pose2& pose, const Cov3& covariance) {
-  if (const InputResult checked = check_initial_pose(pose, covariance); !checked.accepted) return checked;
-  start_from(pose, covariance, timeline_.last_stamp_ns().value_or(stamp_ns));  // no global fix needed
-  return InputResult::ok();
-}
-
-std::optional<PoseEstimate> RangeEkf::estimate() const {
-  if (!initialized_ || !timeline_.last_stamp_ns()) return std::nullopt;
-  PoseEstimate e;
-  e.stamp_ns = *timeline_.last_stamp_ns();
-  e.pose_map_base = ekf_.state();
-  e.covariance = ekf_.covariance();
-  e.status = status();
-  return e;
-}
-
-PoseStatus RangeEkf::status() const {
-  if (!initialized_) return PoseStatus::kInitializing;
-  const PoseStatus s = staleness_.classify(timeline_.last_stamp_ns().value_or(last_correction_stamp_ns_),
-                                           last_correction_stamp_ns_);
-  return suspect_ && s == PoseStatus::kOk ? PoseStatus::kDegraded : s;
-}
-
-std::optional<StartupWait> RangeEkf::startup_wait() const {
-  if (estimate()) return std::nullopt;
-  if (map_.empty()) return StartupWait{StartupCondition::kNoBeaconMap, 0.0, 0.0, {}};
-  if (initialized_) return StartupWait{StartupCondition::kNoOdometry, 0.0, 0.0, {}};
-  return waiting_for_;
 }
 
 namespace {

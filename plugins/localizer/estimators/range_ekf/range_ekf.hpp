@@ -9,9 +9,8 @@
 #include <optional>
 
 #include "beaconloc/core/chi_square.hpp"
-#include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/estimator_base.hpp"
 #include "beaconloc/core/filters/ekf.hpp"
-#include "beaconloc/core/odometry_timeline.hpp"
 #include "beaconloc/core/solvers/range_pose_solver.hpp"
 
 namespace beaconloc {
@@ -44,22 +43,22 @@ struct RangeEkfParameters {
   static RangeEkfParameters from(const EstimatorConfig& config);
 };
 
-class RangeEkf final : public Estimator {
+class RangeEkf final : public EstimatorBase {
  public:
   explicit RangeEkf(const EstimatorConfig& config);
   std::string name() const override { return "range_ekf"; }
-  void set_beacon_map(const BeaconMap& map) override { map_ = map; }
   InputResult predict(const OdometrySample& odometry) override;
   InputResult update(const RangeMeasurement& range) override;
-  InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
-  std::optional<PoseEstimate> estimate() const override;
-  PoseStatus status() const override;
-  std::optional<StartupWait> startup_wait() const override;
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<RangeEkf>(*this); }
   // Re-initializations from a global fix that contradicted a suspect pose.
   std::uint64_t divergence_reinitializations() const { return divergence_reinitializations_; }
 
  private:
+  RangeEkf(const EstimatorConfig& config, const RangeEkfParameters& params);
+  PoseBelief pose_belief() const override { return {ekf_.state(), ekf_.covariance()}; }
+  StartupWait waiting_for() const override { return waiting_for_; }
+  bool place(const Pose2& pose_map_base, const Cov3& covariance) override;
+  bool suspect() const override { return suspect_; }
   struct BufferedRange {
     RangeMeasurement range;
     Pose2 odom_pose_at_range;
@@ -81,19 +80,14 @@ class RangeEkf final : public Estimator {
   };
   InputResult fuse(const RangeMeasurement& range);
   WindowFix window_fix() const;
-  bool attempt_due(StampNs now_ns) const;
+  bool attempt_due(StampNs newest_range_ns) const;
   void try_initialize();
   void watch_divergence(const RangeOutcome& outcome);
   void start_from(const Pose2& pose, const Cov3& covariance, StampNs stamp_ns);
 
   ReceiverArray receivers_;
   RangeEkfParameters params_;
-  StalenessPolicy staleness_;
-  BeaconMap map_;
-  Ekf<3> ekf_;
-  bool initialized_ = false;
-  OdometryTimeline timeline_;
-  StampNs last_correction_stamp_ns_ = 0;
+  Ekf<3> ekf_{pose_space()};
   Pose2 odom_pose_ = Pose2::Zero();  // dead-reckoned, odometry frame
   // The newest ranges, in stamp order, within init_window_s and at most kMaxWindowRanges: 5 slots
   // a second, up to 8 receivers, the longest window (60 s) is 2400; a bus flooding ranges (any

@@ -71,10 +71,10 @@ UkfLrfParameters UkfLrfParameters::from(const EstimatorConfig& c, const std::str
 }
 
 UkfLrf::UkfLrf(const EstimatorConfig& config, Mode mode)
-    : mode_(mode),
-      params_(UkfLrfParameters::from(config, mode_name(mode))),
-      grid_(config.occupancy_grid),
-      timeline_(params_.max_odometry_gap_s) {
+    : UkfLrf(config, mode, UkfLrfParameters::from(config, mode_name(mode))) {}
+
+UkfLrf::UkfLrf(const EstimatorConfig& config, Mode mode, const UkfLrfParameters& params)
+    : EstimatorBase(params.max_odometry_gap_s), mode_(mode), params_(params), grid_(config.occupancy_grid) {
   if (mode_ != Mode::kBeaconsOnly && !grid_) {
     throw std::invalid_argument(name() + " needs the occupancy grid of the map (localizer --map FILE)");
   }
@@ -91,18 +91,19 @@ UkfLrf::UkfLrf(const EstimatorConfig& config, Mode mode)
                                        params_.initial_sigma_xy_m * params_.initial_sigma_xy_m,
                                        params_.initial_sigma_yaw_rad * params_.initial_sigma_yaw_rad)
                            .asDiagonal());
-    initialized_ = true;
+    start(0);
   }
 }
 
 std::string UkfLrf::name() const { return mode_name(mode_); }
 
 InputResult UkfLrf::update(const RangeMeasurement& r) {
-  if (mode_ == Mode::kLaserOnly) return InputResult::rejected("beacons_unused");
+  // A range's numbers first: the same bad range gets the same reason from every estimator.
   if (InputResult numbers = check_range_numbers(r); !numbers.accepted) return numbers;
-  if (r.receiver_id != 0) return InputResult::rejected("unknown_receiver");
-  if (map_.empty()) return InputResult::rejected("no_beacon_map");
-  if (!initialized_) return InputResult::rejected("no_initial_pose");
+  if (mode_ == Mode::kLaserOnly) return InputResult::rejected(Rejection::kBeaconsUnused);
+  if (r.receiver_id != 0) return InputResult::rejected(Rejection::kUnknownReceiver);
+  if (map().empty()) return InputResult::rejected(Rejection::kNoBeaconMap);
+  if (!has_pose()) return InputResult::rejected(Rejection::kNoInitialPose);
   // Anonymous or not, the range is associated (Table 2): the id a beacon may announce is not
   // used, as in the paper (Sec. 4.1). It is fused on its own, not held until the cycle of four
   // is complete as the paper does: the robot moves 6.6 cm between two slots (0.42 m/s, 156 ms).
@@ -110,16 +111,16 @@ InputResult UkfLrf::update(const RangeMeasurement& r) {
 }
 
 InputResult UkfLrf::update_laser(const LaserScanSample& scan) {
-  if (mode_ == Mode::kBeaconsOnly) return InputResult::rejected("laser_unused");
+  if (mode_ == Mode::kBeaconsOnly) return InputResult::rejected(Rejection::kLaserUnused);
   if (scan.ranges_m.empty() || !std::isfinite(scan.angle_min_rad) ||
       !std::isfinite(scan.angle_increment_rad) || scan.angle_increment_rad == 0.0f ||
       !std::isfinite(scan.range_max_m) || !(scan.range_min_m >= 0.0f) ||
       !(scan.range_max_m > scan.range_min_m)) {
-    return InputResult::rejected("malformed_scan");
+    return InputResult::rejected(Rejection::kMalformedScan);
   }
-  if (!initialized_) return InputResult::rejected("no_initial_pose");
+  if (!has_pose()) return InputResult::rejected(Rejection::kNoInitialPose);
   ScanBeams beams = usable_beams(scan);
-  if (beams.ranges_m.empty()) return InputResult::rejected("no_usable_beams");
+  if (beams.ranges_m.empty()) return InputResult::rejected(Rejection::kNoUsableBeams);
   return fuse_or_hold({}, std::move(beams), scan.stamp_ns);
 }
 
@@ -129,10 +130,10 @@ InputResult UkfLrf::update_laser(const LaserScanSample& scan) {
 // measured to bias the laser modes (RMSE 0.0088 -> 0.0120 m: 9 mm of travel per 22 ms step).
 InputResult UkfLrf::fuse_or_hold(std::vector<RangeMeasurement> ranges, std::optional<ScanBeams> beams,
                                  StampNs stamp_ns) {
-  const auto now = timeline_.last_stamp_ns();
+  const auto now = now_ns();
   if (now && stamp_ns <= *now) {
     if (static_cast<double>(*now - stamp_ns) * 1e-9 > params_.max_measurement_age_s) {
-      return InputResult::rejected(beams ? "stale_scan" : "stale_range");
+      return InputResult::rejected(beams ? Rejection::kStaleScan : Rejection::kStaleRange);
     }
     return step(std::nullopt, std::move(ranges), beams ? &*beams : nullptr);
   }
@@ -140,7 +141,7 @@ InputResult UkfLrf::fuse_or_hold(std::vector<RangeMeasurement> ranges, std::opti
     pending_scan_ = std::move(*beams);  // a newer scan replaces one not yet fused
     pending_scan_stamp_ns_ = stamp_ns;
   } else {
-    if (pending_ranges_.size() >= 64) return InputResult::rejected("ranges_without_odometry");
+    if (pending_ranges_.size() >= 64) return InputResult::rejected(Rejection::kRangesWithoutOdometry);
     pending_ranges_.push_back(ranges.front());
   }
   return InputResult::ok();
@@ -164,8 +165,12 @@ UkfLrf::ScanBeams UkfLrf::usable_beams(const LaserScanSample& scan) const {
 }
 
 InputResult UkfLrf::predict(const OdometrySample& o) {
-  if (!initialized_) return InputResult::rejected("no_initial_pose");
-  const OdometryTimeline::Step t = timeline_.advance(o);
+  if (!has_pose()) {
+    // The numbers first: the same bad sample gets the same reason from every estimator.
+    if (InputResult numbers = check_odometry_numbers(o); !numbers.accepted) return numbers;
+    return InputResult::rejected(Rejection::kNoInitialPose);
+  }
+  const OdometryTimeline::Step t = advance(o);
   if (!t.result.accepted) return t.result;
   if (!t.integrate) return InputResult::ok();
   // The measurements held for this step: those stamped up to now.
@@ -187,12 +192,12 @@ InputResult UkfLrf::predict(const OdometrySample& o) {
                       (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / o.wheel_base_m, t.dt_s};
   const InputResult result = step(motion, std::move(due), scan ? &*scan : nullptr);
   if (!result.accepted && !last_step_predicted_) return result;  // nothing applied: the odometry's fault
-  if (!result.accepted) deferred_rejections_.push_back(result.rejection);  // predicted; the correction failed
+  if (!result.accepted) deferred_rejections_.push_back(*result.rejection);  // predicted; the correction failed
   return InputResult::ok();
 }
 
-std::vector<std::string> UkfLrf::take_deferred_rejections() {
-  std::vector<std::string> out;
+std::vector<Rejection> UkfLrf::take_deferred_rejections() {
+  std::vector<Rejection> out;
   out.swap(deferred_rejections_);
   return out;
 }
@@ -224,7 +229,7 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
   }
   const UnscentedWeights w(l, params_.unscented);
   const auto chi_a = sigma_points(mean_a, cov_a, w);  // eq. 2
-  if (!chi_a) return InputResult::rejected("covariance_not_positive_definite");
+  if (!chi_a) return InputResult::rejected(Rejection::kCovarianceNotPositiveDefinite);
   const Eigen::Index n_sigma = chi_a->cols();
 
   // Eq. 9-11: every sigma point moved with its own velocity noise (without motion: as it is).
@@ -256,7 +261,7 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
 
   // Table 2: the predicted range to every beacon over the sigma points, then each measured
   // range's most likely beacon.
-  const std::vector<Beacon> beacons = map_.beacons();
+  const std::vector<Beacon> beacons = map().beacons();
   std::vector<std::uint32_t> associated(n_b);
   if (n_b > 0) {
     std::vector<PredictedBeaconRange> predicted;
@@ -276,7 +281,7 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
     }
     for (int k = 0; k < n_b; ++k) {
       const auto j = most_likely_beacon(ranges[k].range_m, predicted);  // lines 6-11
-      if (!j) return InputResult::rejected("no_beacon_to_associate");
+      if (!j) return InputResult::rejected(Rejection::kNoBeaconToAssociate);
       associated[k] = *j;
     }
   }
@@ -294,7 +299,7 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
     const Pose2 pose(chi_x.col(i));
     for (int k = 0; k < n_b; ++k) {
       z_sigma(k, i) =
-          predict_range(pose, receiver_base_m_, receiver_height_m_, map_.find(associated[k])->position_map_m)
+          predict_range(pose, receiver_base_m_, receiver_height_m_, map().find(associated[k])->position_map_m)
               .range_m;
     }
     if (n_w > 0) expected_laser_ranges(*grid_, pose, scan->beams, z_sigma.col(i).data() + n_b);
@@ -310,7 +315,7 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
   // Eq. 15 prints K = Sigma_xz S; the gain is Sigma_xz S^-1, from a checked LDLT of S.
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(s);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().array() > 0.0).all()) {
-    return InputResult::rejected("singular_innovation");
+    return InputResult::rejected(Rejection::kSingularInnovation);
   }
   const Eigen::MatrixXd k_gain = ldlt.solve(xz.transpose()).transpose();
   Pose2 posterior = prior + k_gain * (z_measured - z_mean);  // eq. 21
@@ -318,10 +323,10 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
   Cov3 posterior_cov = prior_cov - k_gain * s * k_gain.transpose();  // eq. 22
   posterior_cov = symmetrized(posterior_cov);
   if (Eigen::LLT<Cov3>(posterior_cov).info() != Eigen::Success)
-    return InputResult::rejected("covariance_not_positive_definite");
+    return InputResult::rejected(Rejection::kCovarianceNotPositiveDefinite);
   mean_ = posterior;
   covariance_ = posterior_cov;
-  last_correction_stamp_ns_ = *timeline_.last_stamp_ns();
+  corrected(*now_ns());
   for (int k = 0; k < n_b; ++k) {
     // For evaluation against a simulator's truth; bounded, as no one may ever ask.
     if (associations_.size() >= 4096) associations_.erase(associations_.begin());
@@ -336,31 +341,11 @@ std::vector<Estimator::Association> UkfLrf::take_associations() {
   return out;
 }
 
-InputResult UkfLrf::reset(StampNs stamp_ns, const Pose2& pose, const Cov3& covariance) {
-  if (const InputResult checked = check_initial_pose(pose, covariance); !checked.accepted) return checked;
+bool UkfLrf::place(const Pose2& pose, const Cov3& covariance) {
   mean_ = pose;  // placed by hand again (Sec. 4.1)
   mean_.z() = wrap_angle_rad(mean_.z());
   covariance_ = covariance;
-  initialized_ = true;
-  last_correction_stamp_ns_ = timeline_.last_stamp_ns().value_or(stamp_ns);
-  return InputResult::ok();
-}
-
-std::optional<PoseEstimate> UkfLrf::estimate() const {
-  if (!initialized_ || !timeline_.last_stamp_ns()) return std::nullopt;
-  return PoseEstimate{*timeline_.last_stamp_ns(), mean_, covariance_, status()};
-}
-
-std::optional<StartupWait> UkfLrf::startup_wait() const {
-  if (estimate()) return std::nullopt;
-  if (!initialized_) return StartupWait{StartupCondition::kNeedsInitialPose, 0.0, 0.0, {}};
-  return StartupWait{StartupCondition::kNoOdometry, 0.0, 0.0, {}};
-}
-
-PoseStatus UkfLrf::status() const {
-  if (!initialized_) return PoseStatus::kInitializing;
-  return staleness_.classify(timeline_.last_stamp_ns().value_or(last_correction_stamp_ns_),
-                             last_correction_stamp_ns_);
+  return true;
 }
 
 namespace {

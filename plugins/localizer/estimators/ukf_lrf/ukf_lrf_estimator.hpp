@@ -13,10 +13,9 @@
 #include <vector>
 
 #include "beacon_association.hpp"
-#include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/estimator_base.hpp"
 #include "beaconloc/core/filters/unscented.hpp"
-#include "beaconloc/core/odometry_timeline.hpp"
-#include "laser_model.hpp"
+#include "beaconloc/core/models/laser_beam_model.hpp"
 
 namespace beaconloc::ukf_lrf {
 
@@ -41,11 +40,10 @@ struct UkfLrfParameters {
   static UkfLrfParameters from(const EstimatorConfig& config, const std::string& estimator);
 };
 
-class UkfLrf final : public Estimator {
+class UkfLrf final : public EstimatorBase {
  public:
   UkfLrf(const EstimatorConfig& config, Mode mode);
   std::string name() const override;
-  void set_beacon_map(const BeaconMap& map) override { map_ = map; }
   // Placed by hand (seed 001 Sec. 4.1): anonymous ranges cannot give a first pose.
   bool localizes_from_beacons() const override { return false; }
   InputResult predict(const OdometrySample& odometry) override;
@@ -53,14 +51,16 @@ class UkfLrf final : public Estimator {
   bool uses_laser() const override { return mode_ != Mode::kBeaconsOnly; }
   InputResult update_laser(const LaserScanSample& scan) override;
   std::vector<Association> take_associations() override;
-  std::vector<std::string> take_deferred_rejections() override;
-  InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance) override;
-  std::optional<PoseEstimate> estimate() const override;
-  PoseStatus status() const override;
-  std::optional<StartupWait> startup_wait() const override;
+  std::vector<Rejection> take_deferred_rejections() override;
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<UkfLrf>(*this); }
 
  private:
+  UkfLrf(const EstimatorConfig& config, Mode mode, const UkfLrfParameters& params);
+  PoseBelief pose_belief() const override { return {mean_, covariance_}; }
+  // Placed by hand (Sec. 4.1): until then it waits for that, whatever else it has.
+  StartupWait waiting_for() const override { return {StartupCondition::kNeedsInitialPose, 0.0, 0.0, {}}; }
+  bool needs_beacon_map() const override { return false; }
+  bool place(const Pose2& pose_map_base, const Cov3& covariance) override;
   struct Motion {
     double v_mps, omega_radps, dt_s;
   };
@@ -80,19 +80,14 @@ class UkfLrf final : public Estimator {
   std::shared_ptr<const OccupancyGrid> grid_;
   Eigen::Vector2d receiver_base_m_ = Eigen::Vector2d::Zero();
   double receiver_height_m_ = 0.0;
-  BeaconMap map_;
-  OdometryTimeline timeline_;
-  StalenessPolicy staleness_;
   Pose2 mean_ = Pose2::Zero();
   Cov3 covariance_ = Cov3::Identity();
-  bool initialized_ = false;
-  StampNs last_correction_stamp_ns_ = 0;
   std::vector<RangeMeasurement> pending_ranges_;  // stamped after the filter's time
   std::optional<ScanBeams> pending_scan_;
   StampNs pending_scan_stamp_ns_ = 0;
   bool last_step_predicted_ = false;
   std::vector<Association> associations_;
-  std::vector<std::string> deferred_rejections_;
+  std::vector<Rejection> deferred_rejections_;
 };
 
 }  // namespace beaconloc::ukf_lrf

@@ -14,6 +14,7 @@
 #include "beaconloc/core/occupancy_grid.hpp"
 #include "beaconloc/core/pose2.hpp"
 #include "beaconloc/core/receiver_array.hpp"
+#include "beaconloc/core/rejection.hpp"
 
 namespace beaconloc {
 
@@ -34,12 +35,15 @@ struct PoseEstimate {
 // monitor, files) holds to it.
 bool publishable(const PoseEstimate& estimate);
 
-// The answer to one pushed input: accepted, or rejected with a reason (counted in Diagnostics).
+// The answer to one pushed input: accepted, or rejected with a reason (counted in Diagnostics
+// under its stable name, core/rejection.hpp).
 struct InputResult {
   bool accepted = true;
-  std::string rejection;  // empty when accepted; a stable snake_case reason otherwise
+  std::optional<Rejection> rejection;  // set exactly when not accepted
   static InputResult ok() { return {}; }
-  static InputResult rejected(std::string reason) { return {false, std::move(reason)}; }
+  static InputResult rejected(Rejection reason) { return {false, reason}; }
+  // A filter's update or prediction that was not applied.
+  static InputResult refused(FilterOutcome outcome) { return rejected(rejection_for(outcome)); }
 };
 
 struct EstimatorConfig {
@@ -100,7 +104,7 @@ class Estimator {
   // Laser scans, for the estimators that use them (uses_laser()); the others are never pushed one.
   virtual bool uses_laser() const { return false; }
   virtual InputResult update_laser(const LaserScanSample& /*scan*/) {
-    return InputResult::rejected("laser_unused");
+    return InputResult::rejected(Rejection::kLaserUnused);
   }
   // Anonymous ranges the estimator associated with a beacon since last asked (for evaluation
   // against the simulator's truth); empty for estimators that need identified ranges.
@@ -112,12 +116,12 @@ class Estimator {
   virtual std::vector<Association> take_associations() { return {}; }
   // Measurements held for a later step whose fusion then failed (the step itself succeeded),
   // as rejection reasons since last asked: the localizer counts them.
-  virtual std::vector<std::string> take_deferred_rejections() { return {}; }
+  virtual std::vector<Rejection> take_deferred_rejections() { return {}; }
   // Restart from this pose (an operator's or rviz2's initial pose), stamped stamp_ns; the
   // estimators that cannot be placed refuse with a reason.
   virtual InputResult reset(StampNs /*stamp_ns*/, const Pose2& /*pose_map_base*/,
                             const Cov3& /*covariance*/) {
-    return InputResult::rejected("reset_unsupported");
+    return InputResult::rejected(Rejection::kResetUnsupported);
   }
   // The current pose; nullopt until the estimator has one.
   virtual std::optional<PoseEstimate> estimate() const = 0;
@@ -140,8 +144,7 @@ InputResult check_range_numbers(const RangeMeasurement& range);
 InputResult check_range(const RangeMeasurement& range, const BeaconMap& map, std::size_t receiver_count);
 
 // The checks of a pose to reset an estimator from: finite, and a symmetric positive-definite
-// covariance (rejected("invalid_initial_pose")), within the bounds of a site
-// (rejected("implausible_initial_pose")).
+// covariance (kInvalidInitialPose), within the bounds of a site (kImplausibleInitialPose).
 InputResult check_initial_pose(const Pose2& pose_map_base, const Cov3& covariance);
 
 // Status policy shared by estimators: how long without a fused range the pose stays OK.

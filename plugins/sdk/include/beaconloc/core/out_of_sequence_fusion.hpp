@@ -56,7 +56,7 @@ class OutOfSequenceFusion {
 
   const Estimator& estimator() const { return *estimator_; }
   std::vector<Estimator::Association> take_associations();
-  std::vector<std::string> take_deferred_rejections();
+  std::vector<Rejection> take_deferred_rejections();
 
   std::optional<StampNs> newest_odometry_ns() const { return newest_odometry_ns_; }
   std::uint64_t replays() const { return replays_; }
@@ -91,7 +91,7 @@ class OutOfSequenceFusion {
   std::optional<Placement> placed_before_odometry_;  // reset() before the time line began
   int odometry_since_checkpoint_ = 0;
   std::vector<Estimator::Association> associations_;
-  std::vector<std::string> deferred_rejections_;
+  std::vector<Rejection> deferred_rejections_;
   std::uint64_t replays_ = 0;
   std::uint64_t replayed_odometry_steps_ = 0;
 };

@@ -4,12 +4,16 @@
 #include <map>
 #include <string>
 
+#include "beaconloc/core/rejection.hpp"
+
 namespace beaconloc {
 
 class RejectionCounter {
  public:
   void accept() { ++accepted_; }
   void reject(const std::string& reason) { ++rejected_[reason]; }
+  // Counted under prefix + the reason's stable name ("range.gated_nis").
+  void reject(const std::string& prefix, Rejection reason) { ++rejected_[prefix + to_string(reason)]; }
   void reject(const std::string& reason, std::uint64_t count) {
     if (count) rejected_[reason] += count;
   }

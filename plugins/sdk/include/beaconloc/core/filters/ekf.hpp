@@ -1,75 +1,62 @@
 #pragma once
-// Extended Kalman filter on a fixed-size state. The filter knows no model: the caller
-// linearizes its motion and measurement models (kept apart in core/models) and passes the
-// Jacobians, so the same models serve the EKF, IEKF, UKF and H-infinity filters.
-#include <Eigen/Cholesky>
-#include <Eigen/Core>
+// Extended Kalman filter over models (core/models/model_concepts.hpp): predict(motion, u, dt)
+// and update(model, z). The gain comes from a checked LDLT of the innovation covariance, the
+// covariance update is in Joseph form, and the correction is composed in the state space, which
+// wraps the headings (state_space.hpp).
+#include <limits>
 
-#include "beaconloc/core/filters/symmetric.hpp"
+#include "beaconloc/core/filters/gaussian_filter.hpp"
 
 namespace beaconloc {
 
-enum class UpdateOutcome {
-  kApplied,
-  kGated,               // NIS above the gate: the measurement is an outlier for this state
-  kSingularInnovation,  // S not positive definite: nothing applied
-};
-
-struct UpdateResult {
-  UpdateOutcome outcome = UpdateOutcome::kApplied;
-  double nis = 0.0;  // normalized innovation squared nu^T S^-1 nu
-};
-
 template <int N>
-class Ekf {
+class Ekf : public LinearizedFilter<N> {
  public:
-  using State = Eigen::Matrix<double, N, 1>;
-  using Covariance = Eigen::Matrix<double, N, N>;
+  using typename LinearizedFilter<N>::Space;
+  using typename LinearizedFilter<N>::State;
+  using typename LinearizedFilter<N>::Covariance;
+  explicit Ekf(Space space = Space()) : LinearizedFilter<N>(space) {}
 
-  void reset(const State& x, const Covariance& p) {
-    x_ = x;
-    p_ = p;
-  }
-  const State& state() const { return x_; }
-  const Covariance& covariance() const { return p_; }
-  State& mutable_state() { return x_; }
-
-  // P = F P F^T + Q with x already propagated by the motion model.
-  void predict(const State& x_predicted, const Covariance& f, const Covariance& q) {
-    x_ = x_predicted;
-    p_ = f * p_ * f.transpose() + q;
-    p_ = symmetrized(p_);
-  }
-
-  // innovation = z - h(x) (angle components wrapped by the caller), Jacobian H, noise R.
-  // Gain from an LDLT solve of S (checked), Joseph-form covariance update.
-  template <int M>
-  UpdateResult update(const Eigen::Matrix<double, M, 1>& innovation, const Eigen::Matrix<double, M, N>& h,
-                      const Eigen::Matrix<double, M, M>& r, double nis_gate) {
+  // nu = z (-) h(x), S = H P H^T + R, K = P H^T S^-1, x = x (+) K nu,
+  // P = (I - K H) P (I - K H)^T + K R K^T. Not applied when nu^T S^-1 nu > nis_gate (kGated),
+  // S is not positive definite, or the model's numbers are not finite.
+  template <class Model>
+  UpdateResult update(const Model& model, const typename Model::Vector& z,
+                      double nis_gate = std::numeric_limits<double>::infinity()) {
+    static_assert(Model::kHasJacobian, "the EKF linearizes its measurement model: this model has no Jacobian");
+    constexpr int M = Model::kSize;
     UpdateResult result;
-    const Eigen::Matrix<double, M, M> s = h * p_ * h.transpose() + r;
-    const Eigen::LDLT<Eigen::Matrix<double, M, M>> ldlt(s);
-    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || (ldlt.vectorD().array() <= 0.0).any()) {
-      result.outcome = UpdateOutcome::kSingularInnovation;
+    result.iterations = 1;
+    if (const FilterOutcome checked = this->check_measurement(model, z); checked != FilterOutcome::kApplied) {
+      result.outcome = checked;
       return result;
     }
-    result.nis = innovation.dot(ldlt.solve(innovation));
+    const MeasurementLinearization<M, N> lin = model.linearize(this->x_);
+    const Mat<M, M> r = model.noise();
+    if (!lin.predicted.allFinite() || !lin.jacobian.allFinite() || !r.allFinite()) {
+      result.outcome = FilterOutcome::kNonFinite;
+      return result;
+    }
+    const Vec<M> innovation = model.residual(z, lin.predicted);
+    const Mat<M, N>& h = lin.jacobian;
+    const InnovationFactor<M> s(h * this->p_ * h.transpose() + r);
+    if (!s.ok) {
+      result.outcome = FilterOutcome::kSingularInnovation;
+      return result;
+    }
+    result.nis = innovation.dot(s.ldlt.solve(innovation));
     if (!(result.nis <= nis_gate)) {
-      result.outcome = UpdateOutcome::kGated;
+      result.outcome = FilterOutcome::kGated;
       return result;
     }
     // K = P H^T S^-1, computed as (S^-1 H P)^T since S and P are symmetric.
-    const Eigen::Matrix<double, N, M> k = ldlt.solve(h * p_).transpose();
-    x_ += k * innovation;
-    const Covariance i_kh = Covariance::Identity() - k * h;
-    p_ = i_kh * p_ * i_kh.transpose() + k * r * k.transpose();
-    p_ = symmetrized(p_);
+    const Mat<N, M> k = s.ldlt.solve(h * this->p_).transpose();
+    this->x_ = this->space_.plus(this->x_, k * innovation);
+    const Covariance i_kh = Covariance::Identity(this->x_.size(), this->x_.size()) - k * h;
+    this->p_ = i_kh * this->p_ * i_kh.transpose() + k * r * k.transpose();
+    this->p_ = symmetrized(this->p_);
     return result;
   }
-
- private:
-  State x_ = State::Zero();
-  Covariance p_ = Covariance::Identity();
 };
 
 }  // namespace beaconloc

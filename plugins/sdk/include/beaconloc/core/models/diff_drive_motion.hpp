@@ -2,6 +2,7 @@
 // Differential-drive odometry motion model, seed 000 eq. 14 with its Jacobians eq. 16.
 #include <Eigen/Core>
 
+#include "beaconloc/core/models/model_concepts.hpp"
 #include "beaconloc/core/pose2.hpp"
 
 namespace beaconloc {
@@ -10,6 +11,7 @@ struct DiffDrivePrediction {
   Pose2 pose;                                   // x_bar_k of eq. 14
   Eigen::Matrix3d jacobian_pose;                // J_f,x of eq. 16
   Eigen::Matrix<double, 3, 2> jacobian_wheels;  // J_f,u of eq. 16, u = [v_R, v_L]
+  Pose2 step;                                   // x_bar_k - x_k-1 (the heading step unwrapped)
 };
 
 // Eq. 14: Delta D = dT (v_R + v_L) / 2, Delta phi = dT (v_R - v_L) / B_w, the pose advanced along
@@ -19,5 +21,52 @@ struct DiffDrivePrediction {
 // prints the second factor with "R").
 DiffDrivePrediction predict_diff_drive(const Pose2& pose, double wheel_velocity_right_mps,
                                        double wheel_velocity_left_mps, double wheel_base_m, double dt_s);
+
+// Eq. 14 and 16 as a motion model (core/models/model_concepts.hpp) on any state holding the pose
+// at `pose`; the rest of the state stays. Input u = [v_R, v_L] (m/s), its noise U_k of eq. 16
+// the wheel velocities' covariance.
+class DiffDriveMotion {
+ public:
+  static constexpr int kInputSize = 2;
+  static constexpr bool kHasStateNoise = false;
+  using Input = Eigen::Vector2d;
+
+  DiffDriveMotion(double wheel_base_m, const Eigen::Matrix2d& wheel_velocity_covariance, PoseIndex pose = {})
+      : wheel_base_m_(wheel_base_m), covariance_(wheel_velocity_covariance), pose_(pose) {}
+
+  template <int N>
+  Vec<N> step(const Vec<N>& x, const Input& u, double dt_s) const {
+    Vec<N> dx = Vec<N>::Zero(x.size());
+    place(dx, predict_diff_drive(pose_.pose_of(x), u(0), u(1), wheel_base_m_, dt_s).step);
+    return dx;
+  }
+  template <int N>
+  MotionLinearization<N, 2> linearize(const Vec<N>& x, const Input& u, double dt_s) const {
+    const DiffDrivePrediction p = predict_diff_drive(pose_.pose_of(x), u(0), u(1), wheel_base_m_, dt_s);
+    MotionLinearization<N, 2> out;
+    out.step = Vec<N>::Zero(x.size());
+    place(out.step, p.step);
+    out.jacobian_state = Mat<N, N>::Identity(x.size(), x.size());
+    out.jacobian_input = Mat<N, 2>::Zero(x.size(), 2);
+    const Eigen::Index at[3] = {pose_.x, pose_.y, pose_.yaw};
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) out.jacobian_state(at[r], at[c]) = p.jacobian_pose(r, c);
+      out.jacobian_input.row(at[r]) = p.jacobian_wheels.row(r);
+    }
+    return out;
+  }
+  Eigen::Matrix2d input_noise(const Input& /*u*/) const { return covariance_; }
+
+ private:
+  template <int N>
+  void place(Vec<N>& dx, const Pose2& step) const {
+    dx(pose_.x) = step.x();
+    dx(pose_.y) = step.y();
+    dx(pose_.yaw) = step.z();
+  }
+  double wheel_base_m_;
+  Eigen::Matrix2d covariance_;
+  PoseIndex pose_;
+};
 
 }  // namespace beaconloc

@@ -1,8 +1,8 @@
-#include "laser_model.hpp"
+#include "beaconloc/core/models/laser_beam_model.hpp"
 
 #include <cmath>
 
-namespace beaconloc::ukf_lrf {
+namespace beaconloc {
 
 void expected_laser_ranges(const OccupancyGrid& grid, const Pose2& pose, const LaserBeams& beams,
                            double* out) {
@@ -17,4 +17,4 @@ void expected_laser_ranges(const OccupancyGrid& grid, const Pose2& pose, const L
   }
 }
 
-}  // namespace beaconloc::ukf_lrf
+}  // namespace beaconloc

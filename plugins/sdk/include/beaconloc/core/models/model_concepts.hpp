@@ -1,0 +1,52 @@
+#pragma once
+// What a filter (core/filters: EKF, iterated EKF, UKF, H-infinity) asks of its models, so that
+// every filter runs over every model (issue 14; the design of mherb/kalman).
+//
+// A measurement model:
+//   static constexpr int kSize;          // M, the measurement's size; Eigen::Dynamic when it varies
+//   static constexpr bool kHasJacobian;  // false: only the UKF, which needs no Jacobian, takes it
+//   using Vector = Vec<kSize>;
+//   Eigen::Index size() const;                                  // M
+//   template <int N> Vector predict(const Vec<N>& x) const;     // h(x)
+//   template <int N> MeasurementLinearization<kSize, N>
+//       linearize(const Vec<N>& x) const;                       // h(x) and dh/dx (kHasJacobian)
+//   Mat<kSize, kSize> noise() const;                            // R
+//   Vector residual(const Vector& z, const Vector& h) const;    // z - h, angles wrapped
+//
+// A motion model moves a state by an input u over dt_s. It gives the step dx, and the filter
+// composes x (+) dx in its state space (core/filters/state_space.hpp), so that headings are
+// wrapped there and nowhere else:
+//   static constexpr int kInputSize;
+//   static constexpr bool kHasStateNoise;   // true: state_noise() adds Q on the state
+//   using Input = Vec<kInputSize>;
+//   template <int N> Vec<N> step(const Vec<N>& x, const Input& u, double dt_s) const;   // dx
+//   template <int N> MotionLinearization<N, kInputSize>
+//       linearize(const Vec<N>& x, const Input& u, double dt_s) const;               // dx, F, G
+//   Mat<kInputSize, kInputSize> input_noise(const Input& u) const;                     // U
+//   template <int N> Mat<N, N> state_noise(Eigen::Index n, double dt_s) const;        // Q, when kHasStateNoise
+// The EKF's predicted covariance is F P F^T + G U G^T (+ Q); the UKF propagates sigma points of
+// the state augmented with the input noise.
+#include "beaconloc/core/filters/state_space.hpp"
+
+namespace beaconloc {
+
+template <int M, int N>
+struct MeasurementLinearization {
+  Vec<M> predicted;     // h(x)
+  Mat<M, N> jacobian;   // dh/dx at x
+};
+
+template <int N, int U>
+struct MotionLinearization {
+  Vec<N> step;               // dx: the next state is x (+) dx
+  Mat<N, N> jacobian_state;  // F = d(x (+) dx)/dx
+  Mat<N, U> jacobian_input;  // G = d(x (+) dx)/du
+};
+
+// Whether every number of a matrix or vector is finite.
+template <class Derived>
+bool all_finite(const Eigen::MatrixBase<Derived>& m) {
+  return m.allFinite();
+}
+
+}  // namespace beaconloc

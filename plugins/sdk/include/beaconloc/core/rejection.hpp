@@ -1,0 +1,77 @@
+#pragma once
+// Why an input was refused: one enumeration across the decoder, the localizer, its estimators and
+// the bridge's odometry (issue 14), each with a stable snake_case name (to_string) that goes on
+// the wire in Diagnostics. Code decides on the enumerator, never on the name. The same bad input
+// gets the same reason wherever it is checked (core/estimator.hpp check_range_numbers,
+// core/odometry_timeline.hpp check_odometry_numbers).
+#include <cstdint>
+#include <ostream>
+
+#include "beaconloc/core/filters/outcome.hpp"
+
+namespace beaconloc {
+
+enum class Rejection : std::uint8_t {
+  // Odometry (check_odometry_numbers, OdometryTimeline).
+  kNonFiniteOdometry,
+  kInvalidStamp,  // a stamp < 0 (any input)
+  kInvalidWheelBase,
+  kImplausibleWheelBase,
+  kImplausibleWheelSpeed,
+  kInvalidOdometryCovariance,
+  kDuplicateOdometry,
+  kOutOfOrderOdometry,
+  kOdometryGap,          // accepted as the new anchor; the interval before it not integrated
+  kImplausibleOdomPose,  // the bridge's integrated odom pose left the site
+  // Ranges (check_range_numbers, check_range).
+  kNonFiniteRange,
+  kInvalidRange,
+  kImplausibleRange,
+  kUnassociatedRange,  // anonymous, to an estimator that needs identified beacons
+  kNoBeaconMap,
+  kUnknownBeacon,
+  kUnknownReceiver,
+  kStaleRange,
+  kRangesWithoutOdometry,
+  kNoBeaconToAssociate,
+  kBeaconsUnused,  // an estimator mode that takes no beacon ranges
+  // Laser scans.
+  kMalformedScan,
+  kNoUsableBeams,
+  kStaleScan,
+  kLaserUnused,
+  // Out-of-sequence fusion (core/out_of_sequence_fusion.hpp).
+  kTooLate,
+  kAheadOfOdometry,
+  // A filter's update or prediction not applied (core/filters/outcome.hpp).
+  kGatedNis,
+  kSingularInnovation,
+  kCovarianceNotPositiveDefinite,
+  kHInfinityBoundNotMet,
+  kNonFiniteModel,
+  kSizeMismatch,
+  // Placing an estimator.
+  kNoInitialPose,
+  kResetUnsupported,
+  kInvalidInitialPose,
+  kImplausibleInitialPose,
+  // Time of flight (the decoder).
+  kNonFiniteTof,
+  kNegativeTof,
+  kOutOfRangeTof,
+  kBadTemperature,
+  kStaleTof,
+  kDuplicateTof,
+  kBadStamp,
+  kTimeJump,
+};
+inline constexpr int kRejectionCount = static_cast<int>(Rejection::kTimeJump) + 1;
+
+// The stable name on the wire.
+const char* to_string(Rejection r);
+inline std::ostream& operator<<(std::ostream& out, Rejection r) { return out << to_string(r); }
+
+// The rejection a filter's outcome means for the measurement (kApplied is none: not to be asked).
+Rejection rejection_for(FilterOutcome outcome);
+
+}  // namespace beaconloc
