@@ -145,7 +145,7 @@ int run(int argc, char** argv) {
   GatewayOptions gateway_options;
   std::optional<std::uint64_t> seed;
   TofDecoderConfig decoder_config;
-  double max_age_ms = 600.0;
+  double max_age_ms = static_cast<double>(TofDecoderConfig{}.max_age_ns) / 1e6;
   LocalizerSettings localizer_settings;
   bool list_estimators = false;
   std::string out_dir;

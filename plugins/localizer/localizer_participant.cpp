@@ -85,6 +85,17 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       if (auto corrected = core_.on_laser(m.robot_id(), dds::from_msg(m))) publish(*corrected);
     });
   }
+  if (core_.uses_raw_tof()) {
+    // An estimator that turns times of flight into ranges itself (it estimates the speed of
+    // sound, seed 002) reads the gateway's raw_tof beside the decoder's ranges it is never given.
+    participant_.subscribe<msg::RawTofPubSubType>(dds::kRawTofTopic, [this](const msg::RawTof& m) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (auto corrected = core_.on_raw_tof(m.robot_id(), dds::from_msg(m))) publish(*corrected);
+      }
+      ++ranges_processed_;
+    });
+  }
   participant_.subscribe<msg::InitialPosePubSubType>(
       dds::kInitialPoseTopic, [this](const msg::InitialPose& m) {
         Cov3 c;

@@ -27,34 +27,25 @@ class Ekf : public LinearizedFilter<N> {
     constexpr int M = Model::kSize;
     UpdateResult result;
     result.iterations = 1;
-    if (const FilterOutcome checked = this->check_measurement(model, z); checked != FilterOutcome::kApplied) {
-      result.outcome = checked;
-      return result;
-    }
-    const MeasurementLinearization<M, N> lin = model.linearize(this->x_);
     const Mat<M, M> r = model.noise();
-    if (!lin.predicted.allFinite() || !lin.jacobian.allFinite() || !r.allFinite()) {
-      result.outcome = FilterOutcome::kNonFinite;
-      return result;
-    }
-    const Vec<M> innovation = model.residual(z, lin.predicted);
-    const Mat<M, N>& h = lin.jacobian;
+    Vec<M> innovation;
+    Mat<M, N> h;
+    result.outcome = this->check_measurement(model, z, r);
+    if (result.applied()) result.outcome = this->linearize_at(model, z, this->x_, innovation, h);
+    if (!result.applied()) return result;
     const InnovationFactor<M> s(h * this->p_ * h.transpose() + r);
-    if (!s.ok) {
+    if (!s.ok()) {
       result.outcome = FilterOutcome::kSingularInnovation;
       return result;
     }
-    result.nis = innovation.dot(s.ldlt.solve(innovation));
+    result.nis = s.nis(innovation);
     if (!(result.nis <= nis_gate)) {
       result.outcome = FilterOutcome::kGated;
       return result;
     }
-    // K = P H^T S^-1, computed as (S^-1 H P)^T since S and P are symmetric.
-    const Mat<N, M> k = s.ldlt.solve(h * this->p_).transpose();
+    const Mat<N, M> k = this->gain(h, s);
     this->x_ = this->space_.plus(this->x_, k * innovation);
-    const Covariance i_kh = Covariance::Identity(this->x_.size(), this->x_.size()) - k * h;
-    this->p_ = i_kh * this->p_ * i_kh.transpose() + k * r * k.transpose();
-    this->p_ = symmetrized(this->p_);
+    this->joseph_update(k, h, r);
     return result;
   }
 };

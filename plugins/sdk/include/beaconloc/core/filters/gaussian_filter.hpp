@@ -3,6 +3,7 @@
 // space (state_space.hpp), and the linearized prediction the EKF, iterated EKF and H-infinity
 // filters share: x = x (+) dx(x, u), P = F P F^T + G U G^T (+ Q) (core/models/model_concepts.hpp).
 #include <Eigen/Cholesky>
+#include <cmath>
 
 #include "beaconloc/core/filters/outcome.hpp"
 #include "beaconloc/core/filters/state_space.hpp"
@@ -10,6 +11,41 @@
 #include "beaconloc/core/models/model_concepts.hpp"
 
 namespace beaconloc {
+
+// S = H P H^T + R factorized and checked: positive definite, or nothing (ok() false). A scalar S
+// is its own factorization (a division, checked > 0); a larger one an LDLT, whose pivots are
+// checked > 0. The filters solve with S only through solve() and nis().
+template <int M>
+class InnovationFactor {
+ public:
+  explicit InnovationFactor(const Mat<M, M>& s) {
+    if constexpr (M == 1) {
+      scalar_ = s(0, 0);
+      ok_ = scalar_ > 0.0 && std::isfinite(scalar_);
+    } else {
+      ldlt_.compute(s);
+      ok_ = s.allFinite() && ldlt_.info() == Eigen::Success && ldlt_.isPositive() &&
+            (ldlt_.vectorD().array() > 0.0).all();
+    }
+  }
+  bool ok() const { return ok_; }
+  // S^-1 b
+  template <class Rhs>
+  Eigen::Matrix<double, M, Rhs::ColsAtCompileTime> solve(const Eigen::MatrixBase<Rhs>& b) const {
+    if constexpr (M == 1) {
+      return b / scalar_;
+    } else {
+      return ldlt_.solve(b);
+    }
+  }
+  // The normalized innovation squared nu^T S^-1 nu.
+  double nis(const Vec<M>& innovation) const { return innovation.dot(solve(innovation)); }
+
+ private:
+  Eigen::LDLT<Mat<M, M>> ldlt_;
+  double scalar_ = 0.0;
+  bool ok_ = false;
+};
 
 template <int N>
 class GaussianFilter {
@@ -41,11 +77,15 @@ class GaussianFilter {
   const Space& space() const { return space_; }
 
  protected:
-  // Every check of a measurement against the model and the state: sizes and finite numbers.
-  template <class Model>
-  FilterOutcome check_measurement(const Model& model, const typename Model::Vector& z) const {
+  // Every check of a measurement and its noise R (the model's noise()) before an update: both have
+  // the model's size and are finite. kApplied when the update may go on.
+  template <class Model, class Noise>
+  FilterOutcome check_measurement(const Model& model, const typename Model::Vector& z,
+                                  const Eigen::MatrixBase<Noise>& r) const {
     if (z.size() != model.size()) return FilterOutcome::kSizeMismatch;
     if (!z.allFinite()) return FilterOutcome::kNonFinite;
+    if (r.rows() != model.size() || r.cols() != model.size()) return FilterOutcome::kSizeMismatch;
+    if (!r.allFinite()) return FilterOutcome::kNonFinite;
     return FilterOutcome::kApplied;
   }
 
@@ -83,15 +123,35 @@ class LinearizedFilter : public GaussianFilter<N> {
     this->p_ = symmetrized(this->p_);
     return {};
   }
-};
 
-// S = H P H^T + R factorized and checked: positive definite, or nothing.
-template <int M>
-struct InnovationFactor {
-  Eigen::LDLT<Mat<M, M>> ldlt;
-  bool ok = false;
-  explicit InnovationFactor(const Mat<M, M>& s) : ldlt(s) {
-    ok = ldlt.info() == Eigen::Success && ldlt.isPositive() && (ldlt.vectorD().array() > 0.0).all();
+ protected:
+  // h and its Jacobian at x, and the innovation z (-) h(x) (the model's angle-aware residual).
+  // kNonFinite when the model gives a non-finite number, kSizeMismatch when its Jacobian does not
+  // fit the state.
+  template <class Model>
+  FilterOutcome linearize_at(const Model& model, const typename Model::Vector& z, const State& x,
+                             Vec<Model::kSize>& innovation, Mat<Model::kSize, N>& h) const {
+    MeasurementLinearization<Model::kSize, N> lin = model.linearize(x);
+    if (lin.jacobian.rows() != model.size() || lin.jacobian.cols() != x.size() ||
+        lin.predicted.size() != model.size()) {
+      return FilterOutcome::kSizeMismatch;
+    }
+    if (!lin.predicted.allFinite() || !lin.jacobian.allFinite()) return FilterOutcome::kNonFinite;
+    innovation = model.residual(z, lin.predicted);
+    h = std::move(lin.jacobian);
+    return FilterOutcome::kApplied;
+  }
+  // The Kalman gain K = P H^T S^-1, as (S^-1 H P)^T since S and P are symmetric.
+  template <int M>
+  Mat<N, M> gain(const Mat<M, N>& h, const InnovationFactor<M>& s) const {
+    return s.solve(h * this->p_).transpose();
+  }
+  // P = (I - K H) P (I - K H)^T + K R K^T (Joseph form: symmetric and positive semi-definite
+  // whatever the rounding in K).
+  template <int M>
+  void joseph_update(const Mat<N, M>& k, const Mat<M, N>& h, const Mat<M, M>& r) {
+    const Covariance i_kh = Covariance::Identity(this->p_.rows(), this->p_.cols()) - k * h;
+    this->p_ = symmetrized(Covariance(i_kh * this->p_ * i_kh.transpose() + k * r * k.transpose()));
   }
 };
 

@@ -44,6 +44,14 @@ class DiffDriveMotion {
   MotionLinearization<N, 2> linearize(const Vec<N>& x, const Input& u, double dt_s) const {
     const DiffDrivePrediction p = predict_diff_drive(pose_.pose_of(x), u(0), u(1), wheel_base_m_, dt_s);
     MotionLinearization<N, 2> out;
+    if constexpr (N == 3) {
+      if (pose_.x == 0 && pose_.y == 1 && pose_.yaw == 2) {  // the state is the pose: eq. 16 as it is
+        out.step = p.step;
+        out.jacobian_state = p.jacobian_pose;
+        out.jacobian_input = p.jacobian_wheels;
+        return out;
+      }
+    }
     out.step = Vec<N>::Zero(x.size());
     place(out.step, p.step);
     out.jacobian_state = Mat<N, N>::Identity(x.size(), x.size());
