@@ -10,6 +10,7 @@
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/out_of_sequence_fusion.hpp"
 #include "localizer_core.hpp"
+#include "standing_odometry.hpp"
 
 namespace beaconloc {
 namespace {
@@ -52,12 +53,7 @@ class RecordingEstimator : public Estimator {
 BEACONLOC_REGISTER_ESTIMATOR("test_recording", "test double: records the inputs it is pushed", "",
                              [](const EstimatorConfig&) { return std::make_unique<RecordingEstimator>(); });
 
-OdometrySample odometry_at(StampNs stamp_ns) {
-  OdometrySample o;
-  o.stamp_ns = stamp_ns;
-  o.wheel_base_m = 0.4;
-  return o;
-}
+OdometrySample odometry_at(StampNs stamp_ns) { return standing_odometry(stamp_ns); }
 RangeMeasurement range_at(StampNs stamp_ns) {
   RangeMeasurement r;
   r.stamp_ns = stamp_ns;

@@ -12,6 +12,7 @@
 #include "offline_run.hpp"
 #include "sim/scenario.hpp"
 #include "sim/scenario_yaml.hpp"
+#include "standing_odometry.hpp"
 
 namespace beaconloc {
 namespace {
@@ -93,13 +94,7 @@ TEST(OutOfSequenceFusion, UkfFusesLateScansAndAnonymousRangesExactlyAsInOrder) {
                           "ukf_lrf", 4.0, 0);
 }
 
-OdometrySample still_odometry(StampNs stamp_ns) {
-  OdometrySample o;
-  o.stamp_ns = stamp_ns;
-  o.wheel_base_m = 0.33;
-  o.wheel_velocity_covariance = 1e-6 * Eigen::Matrix2d::Identity();
-  return o;
-}
+OdometrySample still_odometry(StampNs stamp_ns) { return standing_odometry(stamp_ns, 0.33, 1e-6); }
 
 TEST(OutOfSequenceFusion, RefusesMeasurementsOlderThanTheHorizonOrAheadOfIt) {
   EstimatorConfig config;

@@ -12,6 +12,7 @@
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/rejection.hpp"
 #include "shipped_estimators.hpp"
+#include "standing_odometry.hpp"
 
 namespace beaconloc {
 namespace {
@@ -56,13 +57,7 @@ std::unique_ptr<Estimator> make(const std::string& name) {
   return EstimatorRegistry::instance().create(name, single);
 }
 
-OdometrySample odometry(StampNs stamp_ns) {
-  OdometrySample o;
-  o.stamp_ns = stamp_ns;
-  o.wheel_base_m = 0.4;
-  o.wheel_velocity_covariance = 1e-4 * Eigen::Matrix2d::Identity();
-  return o;
-}
+OdometrySample odometry(StampNs stamp_ns) { return standing_odometry(stamp_ns); }
 
 TEST(Rejection, TheSameBadRangeGetsTheSameReasonFromEveryEstimator) {
   ASSERT_GE(shipped_estimators().size(), 5u);

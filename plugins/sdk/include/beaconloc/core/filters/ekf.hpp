@@ -27,25 +27,17 @@ class Ekf : public LinearizedFilter<N> {
     constexpr int M = Model::kSize;
     UpdateResult result;
     result.iterations = 1;
-    const Mat<M, M> r = model.noise();
-    Vec<M> innovation;
-    Mat<M, N> h;
-    result.outcome = this->check_measurement(model, z, r);
-    if (result.applied()) result.outcome = this->linearize_at(model, z, this->x_, innovation, h);
+    const auto u = this->linearize_update(model, z);
+    result.outcome = u.outcome;
     if (!result.applied()) return result;
-    const InnovationFactor<M> s(h * this->p_ * h.transpose() + r);
-    if (!s.ok()) {
-      result.outcome = FilterOutcome::kSingularInnovation;
-      return result;
-    }
-    result.nis = s.nis(innovation);
+    result.nis = u.s->nis(u.innovation);
     if (!(result.nis <= nis_gate)) {
       result.outcome = FilterOutcome::kGated;
       return result;
     }
-    const Mat<N, M> k = this->gain(h, s);
-    this->x_ = this->space_.plus(this->x_, k * innovation);
-    this->joseph_update(k, h, r);
+    const Mat<N, M> k = this->gain(u.h, *u.s);
+    this->x_ = this->space_.plus(this->x_, k * u.innovation);
+    this->joseph_update(k, u.h, u.r);
     return result;
   }
 };

@@ -4,6 +4,7 @@
 // filters share: x = x (+) dx(x, u), P = F P F^T + G U G^T (+ Q) (core/models/model_concepts.hpp).
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <optional>
 
 #include "beaconloc/core/filters/outcome.hpp"
 #include "beaconloc/core/filters/state_space.hpp"
@@ -125,6 +126,29 @@ class LinearizedFilter : public GaussianFilter<N> {
   }
 
  protected:
+  // What a linearizing update (EKF, H-infinity; the IEKF's first iterate) starts from: z and R
+  // checked, h and H at the current state, the innovation z (-) h(x), and S = H P H^T + R
+  // factorized. outcome says which step failed (kSingularInnovation for S), kApplied if none.
+  template <int M>
+  struct LinearizedUpdate {
+    FilterOutcome outcome = FilterOutcome::kApplied;
+    Mat<M, M> r;
+    Vec<M> innovation;
+    Mat<M, N> h;
+    std::optional<InnovationFactor<M>> s;  // set once h, H and R are good; ok() once outcome is kApplied
+  };
+  template <class Model>
+  LinearizedUpdate<Model::kSize> linearize_update(const Model& model, const typename Model::Vector& z) const {
+    LinearizedUpdate<Model::kSize> u;
+    u.r = model.noise();
+    u.outcome = this->check_measurement(model, z, u.r);
+    if (u.outcome == FilterOutcome::kApplied) u.outcome = linearize_at(model, z, this->x_, u.innovation, u.h);
+    if (u.outcome != FilterOutcome::kApplied) return u;
+    u.s.emplace(u.h * this->p_ * u.h.transpose() + u.r);
+    if (!u.s->ok()) u.outcome = FilterOutcome::kSingularInnovation;
+    return u;
+  }
+
   // h and its Jacobian at x, and the innovation z (-) h(x) (the model's angle-aware residual).
   // kNonFinite when the model gives a non-finite number, kSizeMismatch when its Jacobian does not
   // fit the state.

@@ -38,21 +38,18 @@ class HInfinityFilter : public LinearizedFilter<N> {
       result.outcome = FilterOutcome::kNonFinite;
       return result;
     }
-    const Mat<M, M> r = model.noise();
-    Vec<M> innovation;
-    Mat<M, N> h;
-    result.outcome = this->check_measurement(model, z, r);
-    if (result.applied()) result.outcome = this->linearize_at(model, z, this->x_, innovation, h);
+    const auto u = this->linearize_update(model, z);
+    result.outcome = u.outcome;
     if (!result.applied()) return result;
-    const InnovationFactor<M> s(h * this->p_ * h.transpose() + r);
-    const InnovationFactor<M> r_factor(r);
+    const InnovationFactor<M> r_factor(u.r);
     const Eigen::Index n = this->x_.size();
     const Eigen::LLT<Covariance> p_factor(this->p_);
-    if (!s.ok() || !r_factor.ok() || p_factor.info() != Eigen::Success) {
-      result.outcome = s.ok() && r_factor.ok() ? FilterOutcome::kNotPositiveDefinite : FilterOutcome::kSingularInnovation;
+    if (!r_factor.ok() || p_factor.info() != Eigen::Success) {
+      result.outcome = r_factor.ok() ? FilterOutcome::kNotPositiveDefinite : FilterOutcome::kSingularInnovation;
       return result;
     }
-    result.nis = s.nis(innovation);
+    const Mat<M, N>& h = u.h;
+    result.nis = u.s->nis(u.innovation);
     if (!(result.nis <= nis_gate)) {
       result.outcome = FilterOutcome::kGated;
       return result;
@@ -67,7 +64,7 @@ class HInfinityFilter : public LinearizedFilter<N> {
     }
     const Covariance p_up = symmetrized(bound.solve(identity));
     const Mat<N, M> k = p_up * r_inv_h.transpose();  // P_up H^T R^-1
-    this->x_ = this->space_.plus(this->x_, k * innovation);
+    this->x_ = this->space_.plus(this->x_, k * u.innovation);
     this->p_ = p_up;
     return result;
   }
