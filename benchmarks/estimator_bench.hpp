@@ -50,8 +50,10 @@ inline EstimatorConfig config_for(const sim::Scenario& s) {
   return c;
 }
 
-// The simulated run (seed `seed`, duration_s) as the estimator's inputs, in arrival order.
-inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t seed, double duration_s) {
+// The simulated run (seed `seed`, duration_s) as the estimator's inputs, in arrival order: its
+// TOFs decoded into ranges, or as raw TOFs for an estimator that uses them (raw_tof).
+inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t seed, double duration_s,
+                                           bool raw_tof = false) {
   sim::SimSource source(s, seed);
   std::vector<SourceEvent> events;
   source.advance(s_to_ns(duration_s), events);
@@ -63,8 +65,8 @@ inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t
   decoder.set_beacon_map(BeaconMap(s.beacons));
   std::vector<Input> out;
   for (const SourceEvent& e : events) {
-    // As the localizer is given them (decoded ranges: no estimator benchmarked uses raw TOFs).
-    if (std::optional<EstimatorInput> in = estimator_input("robot1", e, decoder, false)) {
+    // As the localizer is given them.
+    if (std::optional<EstimatorInput> in = estimator_input("robot1", e, decoder, raw_tof)) {
       out.push_back({std::move(*in), e.truth_map_base});
     }
   }

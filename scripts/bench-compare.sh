@@ -7,8 +7,7 @@
 #
 #   bash scripts/bench-compare.sh [BASE] [ROUNDS] [FILTER]
 #
-#   BASE     the commit to compare with (default: the merge base with main's first parent,
-#            HEAD~1 on main).
+#   BASE     the commit to compare with (default HEAD~1).
 #   ROUNDS   default 4.
 #   FILTER   a --benchmark_filter regex (default: all). Benchmarks only one side has are listed
 #            with "-" on the other.

@@ -64,15 +64,16 @@ OptionSet& OptionSet::unsigned_number(std::string flag, std::optional<std::uint6
   return *this;
 }
 
-OptionSet& OptionSet::text(std::string flag, std::string& value, std::string help, Configure configure) {
+OptionSet& OptionSet::text(std::string flag, std::string& value, std::string help, Configure configure,
+                           Written written) {
   entries_.push_back({flag,
                       [flag, &value, help, configure](CLI::App* app) {
                         CLI::Option* option = app->add_option(flag, value, help);
                         if (configure) configure(option);
                         return option;
                       },
-                      [flag, &value](std::vector<std::string>& out) {
-                        if (value.empty()) return;
+                      [flag, &value, written](std::vector<std::string>& out) {
+                        if (value.empty() && written == Written::kUnlessEmpty) return;
                         out.push_back(flag);
                         out.push_back(value);
                       }});

@@ -30,8 +30,11 @@ class OptionSet {
                    CLI::Validator check);
   // --flag VALUE, a whole number in [0, 2^64 - 1]; written back only when set.
   OptionSet& unsigned_number(std::string flag, std::optional<std::uint64_t>& value, std::string help);
-  // --flag TEXT; written back only when not empty.
-  OptionSet& text(std::string flag, std::string& value, std::string help, Configure configure = {});
+  // --flag TEXT; written back only when not empty (empty: not given), or always (kAlways: an
+  // empty text is a value, unlike the option's default).
+  enum class Written { kUnlessEmpty, kAlways };
+  OptionSet& text(std::string flag, std::string& value, std::string help, Configure configure = {},
+                  Written written = Written::kUnlessEmpty);
   // --flag TEXT, repeatable; written back once per value.
   OptionSet& texts(std::string flag, std::vector<std::string>& values, std::string help,
                    Configure configure = {});

@@ -15,7 +15,7 @@ OptionSet dds_option_set(dds::DdsOptions& o) {
   OptionSet set;
   set.whole("--domain", o.domain_id, "DDS domain id", whole_in(0, 232))
       .text("--participant-profile", o.participant_profile,
-            "participant profile of the QoS XML (default: loopback only)")
+            "participant profile of the QoS XML (default: loopback only)", {}, OptionSet::Written::kAlways)
       .texts("--qos", o.extra_qos_files, "extra Fast DDS XML profiles file(s), loaded last",
              [](CLI::Option* option) { option->check(CLI::ExistingFile); });
   return set;
@@ -40,7 +40,7 @@ OptionSet source_option_set(SourceChoice& s) {
 
 OptionSet gateway_option_set(GatewayOptions& o, std::optional<std::uint64_t>& seed) {
   OptionSet set;
-  set.text("--robot", o.robot_id, "robot id the samples carry")
+  set.text("--robot", o.robot_id, "robot id the samples carry", {}, OptionSet::Written::kAlways)
       .real("--duration-s", o.duration_s,
             "seconds of data to run (0: a recording to its end, a simulation until stopped)",
             real_in(0.0, kMaxDurationS))
@@ -64,7 +64,8 @@ OptionSet decoder_option_set(TofDecoderConfig& o, double& max_age_ms) {
 
 OptionSet localizer_option_set(LocalizerSettings& o, bool standalone) {
   OptionSet set;
-  set.text("--estimator", o.estimator, "estimator plugin (see beaconloc localizer --list-estimators)")
+  set.text("--estimator", o.estimator, "estimator plugin (see beaconloc localizer --list-estimators)", {},
+           OptionSet::Written::kAlways)
       .text("--receivers", o.receivers, "receivers in the robot frame, x:y[,x:y...] (m)")
       .texts("--param", o.parameters, "estimator parameter NAME=VALUE (repeatable)")
       .text("--map", o.map_file,

@@ -1,6 +1,6 @@
 #pragma once
-// The option groups of the beaconloc commands, each defined once (option_set.hpp): main.cpp adds
-// them to its commands, `run --processes` writes them back as its children's command lines.
+// The option groups of the beaconloc commands, each defined once (option_set.hpp): the commands
+// (commands/*.cpp) add them, `run --processes` writes them back as its children's command lines.
 #include <cstdint>
 #include <optional>
 

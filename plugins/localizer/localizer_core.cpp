@@ -123,7 +123,7 @@ std::optional<LocalizerOutput> LocalizerCore::correction_output(const std::strin
 
 std::optional<LocalizerOutput> LocalizerCore::on_range(const std::string& robot_id,
                                                        const RangeMeasurement& range) {
-  return on_measurement(robot_id, range);
+  return on_input(robot_id, range);  // none if uses_raw_tof(): the participant does not subscribe then
 }
 
 std::optional<LocalizerOutput> LocalizerCore::on_laser(const std::string& robot_id,
@@ -137,8 +137,11 @@ std::optional<LocalizerOutput> LocalizerCore::on_raw_tof(const std::string& robo
 
 std::optional<LocalizerOutput> LocalizerCore::on_input(const std::string& robot_id, EstimatorInput input) {
   if (const auto* odometry = std::get_if<OdometrySample>(&input)) return on_odometry(robot_id, *odometry);
+  // What the estimator does not take, the participant does not subscribe to: scans for an
+  // estimator without a laser model; raw TOFs for one of decoded ranges, ranges for one of raw TOFs.
   if (std::holds_alternative<LaserScanSample>(input) && !uses_laser_) return std::nullopt;
   if (std::holds_alternative<RawTofSample>(input) && !uses_raw_tof_) return std::nullopt;
+  if (std::holds_alternative<RangeMeasurement>(input) && uses_raw_tof_) return std::nullopt;
   return on_measurement(robot_id, std::move(input));
 }
 

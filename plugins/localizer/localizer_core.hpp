@@ -48,7 +48,8 @@ class LocalizerCore {
   bool has_beacon_map() const { return !map_.empty(); }
   const BeaconMap& beacon_map() const { return map_; }
   std::uint64_t beacon_map_changes() const { return beacon_map_changes_; }
-  // Any input: odometry to on_odometry, a measurement to on_range, on_laser or on_raw_tof.
+  // Any input: odometry to on_odometry; a range, scan or raw TOF fused at its stamp (nothing for
+  // a kind the estimator does not take: see on_range, on_laser, on_raw_tof).
   std::optional<LocalizerOutput> on_input(const std::string& robot_id, EstimatorInput input);
   // Predicts; returns the pose to publish once the robot's estimator has one.
   std::optional<LocalizerOutput> on_odometry(const std::string& robot_id, const OdometrySample& odometry);
@@ -62,7 +63,8 @@ class LocalizerCore {
   bool uses_laser() const { return uses_laser_; }
   std::optional<LocalizerOutput> on_laser(const std::string& robot_id, const LaserScanSample& scan);
   // Raw times of flight reach estimators that turn them into ranges themselves (uses_raw_tof(),
-  // seed 002); the others are given decoded ranges and never see one.
+  // seed 002), and are never given decoded ranges; the others are given decoded ranges and never
+  // see a raw TOF.
   bool uses_raw_tof() const { return uses_raw_tof_; }
   std::optional<LocalizerOutput> on_raw_tof(const std::string& robot_id, const RawTofSample& tof);
   // Restarts the robot's estimator from a given pose (counted as initial_pose.<reason> if refused).

@@ -120,7 +120,7 @@ TEST(EstimatorInput, ALateRawTofIsReplayedAtItsStampAmongTheOtherKinds) {
   EXPECT_EQ(fusion.push(tof_fired_at(-700 * ms)).rejection, Rejection::kTooLate);
 }
 
-TEST(EstimatorInput, TheLocalizerGivesRawTofsOnlyToEstimatorsThatUseThem) {
+TEST(EstimatorInput, TheLocalizerGivesRawTofsOnlyToEstimatorsThatUseThemAndThemNoRanges) {
   EstimatorConfig config;
   config.receivers = ReceiverArray::on_circle(0.19, 3);
   LocalizerCore raw("test_recording", config);
@@ -129,6 +129,10 @@ TEST(EstimatorInput, TheLocalizerGivesRawTofsOnlyToEstimatorsThatUseThem) {
   EXPECT_TRUE(raw.on_raw_tof("r", tof_fired_at(5)).has_value());  // fused: the corrected pose goes out
   EXPECT_FALSE(raw.on_raw_tof("r", tof_fired_at(6, -1.0)).has_value());
   EXPECT_EQ(raw.counts().rejected("raw_tof.negative_tof"), 1u);
+  // ... and never the decoder's ranges of the same pulses: each pulse reaches it once.
+  EXPECT_FALSE(raw.on_range("r", range_at(7)).has_value());
+  EXPECT_FALSE(raw.on_input("r", range_at(8)).has_value());
+  EXPECT_EQ(raw.counts().accepted(), 2u);  // the odometry sample and the one good raw TOF
 
   LocalizerCore ranges("range_ekf", config);
   EXPECT_FALSE(ranges.uses_raw_tof());

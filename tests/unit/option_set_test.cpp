@@ -76,6 +76,44 @@ TEST(OptionSets, WhatACommandParsedItsChildParsesBackBitForBit) {
   EXPECT_EQ(child.decoder.max_age_ns, parent.decoder.max_age_ns);
 }
 
+TEST(OptionSets, TheLocalizersSettingsReachItsChildBitForBit) {
+  LocalizerSettings parent;
+  {
+    CLI::App app;
+    localizer_option_set(parent, true).add_to(&app);
+    std::vector<std::string> args{"beaconloc",   "--estimator",    "duhl",     "--receivers", "0.19:0,-0.095:0.16454482671904333",
+                                  "--param",     "nis_gate=9.5",   "--param",  "init_window_s=4", "--initial-pose",
+                                  "1.25",        "-2.5",           "0.30000000000000004", "--robot", "r9",
+                                  "--receiver-height-m", "0.123456789012345678"};
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    app.parse(static_cast<int>(argv.size()), argv.data());
+  }
+  LocalizerSettings child;
+  CLI::App app;
+  localizer_option_set(child, true).add_to(&app);
+  std::vector<std::string> args = localizer_option_set(parent, true).arguments();
+  args.insert(args.begin(), "beaconloc");
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  app.parse(static_cast<int>(argv.size()), argv.data());
+  EXPECT_EQ(child.estimator, "duhl");
+  EXPECT_EQ(child.receivers, parent.receivers);
+  EXPECT_EQ(child.parameters, (std::vector<std::string>{"nis_gate=9.5", "init_window_s=4"}));
+  EXPECT_EQ(child.initial_pose, (std::vector<double>{1.25, -2.5, 0.30000000000000004}));
+  EXPECT_EQ(child.robot, "r9");
+  EXPECT_EQ(child.receiver_height_m, parent.receiver_height_m);
+  EXPECT_EQ(child.receiver_count, parent.receiver_count);
+}
+
+TEST(OptionSets, AnEmptyRobotIdIsAValueTheChildKeeps) {
+  Settings parent;
+  parent.parse({"--robot", ""});
+  Settings child;
+  child.parse(parent.arguments());
+  EXPECT_EQ(child.gateway.robot_id, "");
+}
+
 TEST(OptionSets, WhatWasNotSetIsNotWrittenForTheChild) {
   Settings parent;
   parent.parse({});

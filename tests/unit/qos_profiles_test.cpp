@@ -81,8 +81,10 @@ TEST(QosProfiles, TheMeasurementLifespansAreTheHorizon) {
     const tinyxml2::XMLElement* lifespan = qos ? qos->FirstChildElement("lifespan") : nullptr;
     const tinyxml2::XMLElement* duration = lifespan ? lifespan->FirstChildElement("duration") : nullptr;
     ASSERT_NE(duration, nullptr) << profile << " has no lifespan";
-    const StampNs lifespan_ns = duration->FirstChildElement("sec")->Int64Text() * kNsPerSecond +
-                                duration->FirstChildElement("nanosec")->Int64Text();
+    const tinyxml2::XMLElement* sec = duration->FirstChildElement("sec");
+    const tinyxml2::XMLElement* nanosec = duration->FirstChildElement("nanosec");
+    ASSERT_TRUE(sec && nanosec) << profile << ": a lifespan without sec and nanosec";
+    const StampNs lifespan_ns = sec->Int64Text() * kNsPerSecond + nanosec->Int64Text();
     EXPECT_EQ(lifespan_ns, kMeasurementHorizonNs) << profile;
     ++checked;
   }

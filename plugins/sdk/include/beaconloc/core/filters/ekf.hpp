@@ -1,8 +1,9 @@
 #pragma once
 // Extended Kalman filter over models (core/models/model_concepts.hpp): predict(motion, u, dt)
-// and update(model, z). The gain comes from a checked LDLT of the innovation covariance, the
-// covariance update is in Joseph form, and the correction is composed in the state space, which
-// wraps the headings (state_space.hpp).
+// and update(model, z). The gain comes from a checked factorization of the innovation covariance
+// (InnovationFactor: a division for a scalar, an LDLT otherwise), the covariance update is in
+// Joseph form, and the correction is composed in the state space, which wraps the headings
+// (state_space.hpp).
 #include <limits>
 
 #include "beaconloc/core/filters/gaussian_filter.hpp"

@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <optional>
+#include <type_traits>
 
 #include "beaconloc/core/filters/outcome.hpp"
 #include "beaconloc/core/filters/state_space.hpp"
@@ -21,12 +22,12 @@ class InnovationFactor {
  public:
   explicit InnovationFactor(const Mat<M, M>& s) {
     if constexpr (M == 1) {
-      scalar_ = s(0, 0);
-      ok_ = scalar_ > 0.0 && std::isfinite(scalar_);
+      factor_ = s(0, 0);
+      ok_ = factor_ > 0.0 && std::isfinite(factor_);
     } else {
-      ldlt_.compute(s);
-      ok_ = s.allFinite() && ldlt_.info() == Eigen::Success && ldlt_.isPositive() &&
-            (ldlt_.vectorD().array() > 0.0).all();
+      factor_.compute(s);
+      ok_ = s.allFinite() && factor_.info() == Eigen::Success && factor_.isPositive() &&
+            (factor_.vectorD().array() > 0.0).all();
     }
   }
   bool ok() const { return ok_; }
@@ -34,17 +35,16 @@ class InnovationFactor {
   template <class Rhs>
   Eigen::Matrix<double, M, Rhs::ColsAtCompileTime> solve(const Eigen::MatrixBase<Rhs>& b) const {
     if constexpr (M == 1) {
-      return b / scalar_;
+      return b / factor_;
     } else {
-      return ldlt_.solve(b);
+      return factor_.solve(b);
     }
   }
   // The normalized innovation squared nu^T S^-1 nu.
   double nis(const Vec<M>& innovation) const { return innovation.dot(solve(innovation)); }
 
  private:
-  Eigen::LDLT<Mat<M, M>> ldlt_;
-  double scalar_ = 0.0;
+  std::conditional_t<M == 1, double, Eigen::LDLT<Mat<M, M>>> factor_{};  // s itself, or its LDLT
   bool ok_ = false;
 };
 
@@ -104,29 +104,25 @@ class LinearizedFilter : public GaussianFilter<N> {
   using typename GaussianFilter<N>::Covariance;
   explicit LinearizedFilter(Space space = Space()) : GaussianFilter<N>(space) {}
 
-  // x = x (+) dx, P = F P F^T + G U G^T (+ Q). Not applied (kNonFinite) when the model's step,
-  // Jacobians or noise are not finite.
+  // x = x (+) dx, P = F P F^T + G U G^T (+ Q). Not applied (kNonFinite, nothing changed) when
+  // the model's step, Jacobians or noise are not finite: checked on the result, which any
+  // non-finite number among them makes non-finite (NaN and inf propagate through the products,
+  // inf * 0 included), at half the cost of checking each.
   template <class Motion>
   PredictResult predict(const Motion& motion, const typename Motion::Input& u, double dt_s) {
     const MotionLinearization<N, Motion::kInputSize> m = motion.linearize(this->x_, u, dt_s);
-    const Mat<Motion::kInputSize, Motion::kInputSize> input_noise = motion.input_noise(u);
-    if (!m.step.allFinite() || !m.jacobian_state.allFinite() || !m.jacobian_input.allFinite() ||
-        !input_noise.allFinite()) {
-      return {FilterOutcome::kNonFinite};
-    }
-    Covariance q = m.jacobian_input * input_noise * m.jacobian_input.transpose();
-    if constexpr (Motion::kHasStateNoise) {
-      q += motion.template state_noise<N>(this->space_.dimension(), dt_s);
-      if (!q.allFinite()) return {FilterOutcome::kNonFinite};
-    }
-    this->x_ = this->space_.plus(this->x_, m.step);
-    this->p_ = m.jacobian_state * this->p_ * m.jacobian_state.transpose() + q;
-    this->p_ = symmetrized(this->p_);
+    Covariance p = m.jacobian_state * this->p_ * m.jacobian_state.transpose() +
+                   m.jacobian_input * motion.input_noise(u) * m.jacobian_input.transpose();
+    if constexpr (Motion::kHasStateNoise) p += motion.template state_noise<N>(this->space_.dimension(), dt_s);
+    const State x = this->space_.plus(this->x_, m.step);
+    if (!x.allFinite() || !p.allFinite()) return {FilterOutcome::kNonFinite};
+    this->x_ = x;
+    this->p_ = symmetrized(p);
     return {};
   }
 
  protected:
-  // What a linearizing update (EKF, H-infinity; the IEKF's first iterate) starts from: z and R
+  // What a linearizing update (EKF, H-infinity) starts from: z and R
   // checked, h and H at the current state, the innovation z (-) h(x), and S = H P H^T + R
   // factorized. outcome says which step failed (kSingularInnovation for S), kApplied if none.
   template <int M>

@@ -8,7 +8,7 @@
 namespace beaconloc {
 
 struct DiffDrivePrediction {
-  Pose2 pose;                                   // x_bar_k of eq. 14
+  Pose2 pose;                                   // x_bar_k of eq. 14 (diff_drive_step: the pose given)
   Eigen::Matrix3d jacobian_pose;                // J_f,x of eq. 16
   Eigen::Matrix<double, 3, 2> jacobian_wheels;  // J_f,u of eq. 16, u = [v_R, v_L]
   Pose2 step;                                   // x_bar_k - x_k-1 (the heading step unwrapped)
