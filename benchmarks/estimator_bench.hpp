@@ -11,10 +11,12 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "beaconloc/core/estimator.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
+#include "offline_run.hpp"
 #include "sim/scenario.hpp"
 #include "sim/scenario_yaml.hpp"
 #include "sim/sim_source.hpp"
@@ -22,15 +24,18 @@
 
 namespace beaconloc::bench {
 
-// One input as the localizer pushes it to its estimator.
+// One input as the localizer pushes it to its estimator, with the simulator's truth.
 struct Input {
-  enum class Kind { kOdometry, kRange, kScan };
-  Kind kind = Kind::kOdometry;
-  StampNs stamp_ns = 0;
-  OdometrySample odometry;
-  RangeMeasurement range;
-  LaserScanSample scan;
-  Pose2 truth = Pose2::Zero();  // the simulator's truth, on odometry inputs
+  EstimatorInput input;
+  Pose2 truth = Pose2::Zero();  // on odometry inputs
+  template <class T>
+  bool is() const {
+    return std::holds_alternative<T>(input);
+  }
+  template <class T>
+  const T& as() const {
+    return std::get<T>(input);
+  }
 };
 
 inline sim::Scenario scenario_file(const std::string& name) {
@@ -45,8 +50,10 @@ inline EstimatorConfig config_for(const sim::Scenario& s) {
   return c;
 }
 
-// The simulated run (seed `seed`, duration_s) as the estimator's inputs, in arrival order.
-inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t seed, double duration_s) {
+// The simulated run (seed `seed`, duration_s) as the estimator's inputs, in arrival order: its
+// TOFs decoded into ranges, or as raw TOFs for an estimator that uses them (raw_tof).
+inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t seed, double duration_s,
+                                           bool raw_tof = false) {
   sim::SimSource source(s, seed);
   std::vector<SourceEvent> events;
   source.advance(s_to_ns(duration_s), events);
@@ -58,43 +65,12 @@ inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t
   decoder.set_beacon_map(BeaconMap(s.beacons));
   std::vector<Input> out;
   for (const SourceEvent& e : events) {
-    Input in;
-    in.stamp_ns = e.stamp_ns;
-    switch (e.kind) {
-      case SourceEvent::Kind::kOdometry:
-        in.kind = Input::Kind::kOdometry;
-        in.odometry = e.odometry;
-        in.truth = e.truth_map_base;
-        break;
-      case SourceEvent::Kind::kTof: {
-        const DecodeOutcome d = decoder.decode("robot1", e.tof);
-        if (!d.range) continue;
-        in.kind = Input::Kind::kRange;
-        in.range = d.range->range;
-        break;
-      }
-      case SourceEvent::Kind::kLaserScan:
-        in.kind = Input::Kind::kScan;
-        in.scan = e.scan;
-        break;
-      case SourceEvent::Kind::kTruth:
-        continue;
+    // As the localizer is given them.
+    if (std::optional<EstimatorInput> in = estimator_input("robot1", e, decoder, raw_tof)) {
+      out.push_back({std::move(*in), e.truth_map_base});
     }
-    out.push_back(std::move(in));
   }
   return out;
-}
-
-inline InputResult push(Estimator& e, const Input& in) {
-  switch (in.kind) {
-    case Input::Kind::kOdometry:
-      return e.predict(in.odometry);
-    case Input::Kind::kRange:
-      return e.update(in.range);
-    case Input::Kind::kScan:
-      return e.update_laser(in.scan);
-  }
-  throw std::logic_error("unknown input kind");
 }
 
 // An estimator as it was at a moment of the run, and the inputs of the step timed from there.
@@ -110,7 +86,7 @@ inline std::vector<Input> next_step(const std::vector<Input>& inputs, std::size_
   std::vector<Input> step;
   for (std::size_t j = k + 1; j < inputs.size(); ++j) {
     step.push_back(inputs[j]);
-    if (inputs[j].kind == Input::Kind::kOdometry) return step;
+    if (inputs[j].is<OdometrySample>()) return step;
   }
   return {};
 }
@@ -125,17 +101,18 @@ inline Snapshot find_snapshot(const std::string& name, const EstimatorConfig& co
   e->set_beacon_map(map);
   Pose2 truth = Pose2::Zero();
   for (std::size_t k = 0; k < inputs.size(); ++k) {
-    push(*e, inputs[k]);
-    if (inputs[k].kind == Input::Kind::kOdometry) truth = inputs[k].truth;
-    if (inputs[k].stamp_ns < s_to_ns(warmup_s)) continue;
+    e->push(inputs[k].input);
+    if (inputs[k].is<OdometrySample>()) truth = inputs[k].truth;
+    if (stamp_of(inputs[k].input) < s_to_ns(warmup_s)) continue;
     if (auto step = step_at(*e, inputs, k)) return {e->clone(), std::move(*step), truth};
   }
   throw std::logic_error(name + ": no snapshot as the benchmark wants in the simulated run");
 }
 
-inline std::size_t count(const std::vector<Input>& step, Input::Kind kind) {
+template <class T>
+std::size_t count(const std::vector<Input>& step) {
   std::size_t n = 0;
-  for (const Input& in : step) n += in.kind == kind ? 1 : 0;
+  for (const Input& in : step) n += in.is<T>() ? 1 : 0;
   return n;
 }
 
@@ -144,7 +121,7 @@ inline std::size_t count(const std::vector<Input>& step, Input::Kind kind) {
 inline void require_accepted(const Snapshot& s, const std::string& what) {
   auto e = s.estimator->clone();
   for (const Input& in : s.step) {
-    const InputResult r = push(*e, in);
+    const InputResult r = e->push(in.input);
     if (!r.accepted) throw std::logic_error(what + ": input refused (" + std::string(to_string(*r.rejection)) + ")");
   }
   for (const auto& r : e->take_deferred_rejections()) throw std::logic_error(what + ": deferred " + to_string(r));
@@ -154,7 +131,7 @@ inline void require_accepted(const Snapshot& s, const std::string& what) {
 // (valgrind --tool=callgrind --collect-atstart=no --toggle-collect='beaconloc::bench::run_step*').
 [[gnu::noinline]] inline void run_step(Estimator& e, const std::vector<Input>& step) {
   for (const Input& in : step) {
-    InputResult r = push(e, in);
+    InputResult r = e.push(in.input);
     benchmark::DoNotOptimize(r);
   }
 }

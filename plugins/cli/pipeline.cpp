@@ -9,7 +9,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <iomanip>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
@@ -23,6 +22,7 @@
 #include "diagnostics_recorder.hpp"
 #include "lead_limiter.hpp"
 #include "localizer_participant.hpp"
+#include "options.hpp"
 #include "pose_recorder.hpp"
 #include "sim/faults.hpp"
 #include "sim/scenario_yaml.hpp"
@@ -168,13 +168,14 @@ void wait_until_drained(const PoseRecorder& recorder) {
   }
 }
 
+// "x:y,x:y,...", each number written to read back exactly (exact_number).
 std::string join_receivers(const ReceiverArray& receivers) {
-  std::ostringstream s;
-  s << std::setprecision(10);
+  std::string s;
   for (std::size_t i = 0; i < receivers.size(); ++i) {
-    s << (i ? "," : "") << receivers.receivers_base_m[i].x() << ':' << receivers.receivers_base_m[i].y();
+    s += (i ? "," : "") + exact_number(receivers.receivers_base_m[i].x()) + ':' +
+         exact_number(receivers.receivers_base_m[i].y());
   }
-  return s.str();
+  return s;
 }
 
 void print_pose_line(double t_s, const PoseRecorder& recorder) {
@@ -328,20 +329,14 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
   return finish(o, described, beacons, recorder.poses(), truth, diag.str());
 }
 
-std::vector<std::string> dds_arguments(const dds::DdsOptions& d) {
-  std::vector<std::string> a{"--domain", std::to_string(d.domain_id), "--participant-profile",
-                             d.participant_profile};
-  for (const auto& f : d.extra_qos_files) {
-    a.push_back("--qos");
-    a.push_back(f);
+// The arguments a child process is started with: option groups written back (options.hpp).
+template <class... Sets>
+std::vector<std::string> command_line(std::string command, const Sets&... sets) {
+  std::vector<std::string> out{std::move(command)};
+  for (const OptionSet* set : {&sets...}) {
+    for (std::string& a : set->arguments()) out.push_back(std::move(a));
   }
-  return a;
-}
-
-std::string number(double v) {
-  std::ostringstream s;
-  s << std::setprecision(17) << v;
-  return s.str();
+  return out;
 }
 
 PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, const std::string& exe) {
@@ -360,40 +355,19 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
   // An unknown estimator or a bad parameter fails here, at start, rather than in the child's log.
   [[maybe_unused]] const LocalizerCore checked(localizer_settings.estimator,
                                                localizer_settings.config(receivers));
-  auto localizer_args = std::vector<std::string>{"localizer"};
-  for (const auto& a : dds_arguments(o.dds)) localizer_args.push_back(a);
+  dds::DdsOptions dds = o.dds;
+  std::vector<std::string> localizer_args = command_line("localizer", dds_option_set(dds));
   for (const auto& a : localizer_settings.arguments(receivers)) localizer_args.push_back(a);
-  auto decoder_args = std::vector<std::string>{"decoder"};
-  for (const auto& a : dds_arguments(o.dds)) decoder_args.push_back(a);
-  for (const auto& a : std::vector<std::string>{
-           "--min-range-m", number(o.decoder.min_range_m), "--max-range-m", number(o.decoder.max_range_m),
-           "--range-sigma-m", number(o.decoder.range_sigma_m), "--range-scale", number(o.decoder.range_scale),
-           "--max-age-ms", number(static_cast<double>(o.decoder.max_age_ns) / 1e6)}) {
-    decoder_args.push_back(a);
-  }
-  auto gateway_args = std::vector<std::string>{"gateway"};
-  for (const auto& a : dds_arguments(o.dds)) gateway_args.push_back(a);
-  for (const auto& a :
-       std::vector<std::string>{"--robot", o.gateway.robot_id, "--speed", number(o.gateway.speed), "--seed",
-                                std::to_string(o.gateway.seed), "--duration-s", number(o.gateway.duration_s),
-                                "--truth-out", o.out_dir + "/truth.csv"}) {
-    gateway_args.push_back(a);
-  }
-  if (!source.choice.replay_dir.empty()) {
-    for (const auto& a :
-         std::vector<std::string>{"--replay", source.choice.replay_dir, "--replay-wheel-base-m",
-                                  number(source.choice.replay.wheel_base_m), "--replay-odometry-k-v",
-                                  number(source.choice.replay.odometry_k_v_m)}) {
-      gateway_args.push_back(a);
-    }
-  } else if (!source.choice.scenario_file.empty()) {
-    gateway_args.push_back("--scenario");
-    gateway_args.push_back(source.choice.scenario_file);
-  }
-  for (const auto& fault : source.choice.faults) {
-    gateway_args.push_back("--fault");
-    gateway_args.push_back(fault);
-  }
+  TofDecoderConfig decoder_config = o.decoder;
+  double max_age_ms = max_age_ms_of(o.decoder);
+  const std::vector<std::string> decoder_args =
+      command_line("decoder", dds_option_set(dds), decoder_option_set(decoder_config, max_age_ms));
+  GatewayOptions gateway_options = o.gateway;
+  gateway_options.truth_csv = o.out_dir + "/truth.csv";
+  std::optional<std::uint64_t> seed = o.gateway.seed;
+  SourceChoice choice = source.choice;
+  const std::vector<std::string> gateway_args = command_line(
+      "gateway", dds_option_set(dds), gateway_option_set(gateway_options, seed), source_option_set(choice));
 
   ChildProcess localizer(exe, localizer_args, o.out_dir + "/localizer.log");
   ChildProcess decoder(exe, decoder_args, o.out_dir + "/decoder.log");
@@ -519,27 +493,12 @@ LocalizerSettings with_scenario_defaults(LocalizerSettings s, const LoadedSource
 }
 
 std::vector<std::string> LocalizerSettings::arguments(const std::optional<ReceiverArray>& fallback) const {
+  // The receivers the settings resolve to, given explicitly: the child has no source to ask.
   const EstimatorConfig c = config(fallback);
-  std::vector<std::string> a{"--estimator",         estimator,
-                             "--receivers",         join_receivers(c.receivers),
-                             "--receiver-height-m", number(c.receivers.receiver_height_m)};
-  if (!robot.empty()) {
-    a.push_back("--robot");
-    a.push_back(robot);
-  }
-  for (const auto& p : parameters) {
-    a.push_back("--param");
-    a.push_back(p);
-  }
-  if (!map_file.empty()) {
-    a.push_back("--map");
-    a.push_back(map_file);
-  }
-  if (!initial_pose.empty()) {
-    a.push_back("--initial-pose");
-    for (double v : initial_pose) a.push_back(number(v));
-  }
-  return a;
+  LocalizerSettings child = *this;
+  child.receivers = join_receivers(c.receivers);
+  child.receiver_height_m = c.receivers.receiver_height_m;
+  return localizer_option_set(child, true).arguments();
 }
 
 PipelineResult run_pipeline(const PipelineOptions& options, LoadedSource source,

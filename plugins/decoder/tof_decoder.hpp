@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "beaconloc/core/beacon_map.hpp"
+#include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/measurements.hpp"
 #include "beaconloc/core/rejection.hpp"
 #include "beaconloc/core/rejection_counter.hpp"
@@ -30,7 +31,7 @@ struct TofDecoderConfig {
   double range_sigma_m = 0.01;  // seed 000 sigma_dd, measured by the paper
   double min_temperature_c = -30.0;
   double max_temperature_c = 60.0;
-  StampNs max_age_ns = 600 * kNsPerMillisecond;  // three 200 ms slots
+  StampNs max_age_ns = kMeasurementHorizonNs;
   // A firing this far (five slots; at least twice max_age_ns) behind the robot's newest is a
   // clock that stepped back, or the true time line after one bad stamp far ahead: refused
   // (time_jump) until a second, different firing within max_age_ns of it confirms it, then

@@ -9,7 +9,9 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
       config_(std::move(config)),
       robot_filter_(std::move(robot_filter)) {
   // Fail at start, not at the first sample, when the name or the configuration is wrong.
-  uses_laser_ = EstimatorRegistry::instance().create(estimator_name_, config_)->uses_laser();
+  const auto probe = EstimatorRegistry::instance().create(estimator_name_, config_);
+  uses_laser_ = probe->uses_laser();
+  uses_raw_tof_ = probe->uses_raw_tof();
 }
 
 bool LocalizerCore::on_beacon_map(const std::vector<Beacon>& beacons) {
@@ -38,7 +40,7 @@ InputResult LocalizerCore::restart_robot(Robot& r, const OdometrySample* next) {
   restart.initial_pose.reset();  // not the run's start pose
   r = Robot(EstimatorRegistry::instance().create(estimator_name_, restart));
   r.fusion.set_beacon_map(map_);
-  const InputResult result = next ? r.fusion.predict(*next) : InputResult::ok();
+  const InputResult result = next ? r.fusion.push(*next) : InputResult::ok();
   if (!r.fusion.estimator().localizes_from_beacons() && before && publishable(*before) && result.accepted) {
     // Placed where it was, less sure by 0.1 m and 0.1 rad (standard deviations).
     const Cov3 inflated = before->covariance + Eigen::Vector3d(0.01, 0.01, 0.01).asDiagonal().toDenseMatrix();
@@ -70,7 +72,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
   Robot* r = robot(robot_id, "odometry");
   if (!r) return std::nullopt;
   r->odometry_deadlines_missed = 0;  // the bus delivers odometry again
-  InputResult result = r->fusion.predict(odometry);
+  InputResult result = r->fusion.push(odometry);
   for (const auto& reason : r->fusion.take_deferred_rejections()) counts_.reject("deferred.", reason);
   if (!result.accepted && result.rejection == Rejection::kOutOfOrderOdometry && clock_jumped_back(*r, odometry)) {
     // The robot's clock stepped back (a restarted gateway replaying, a reset clock): what the
@@ -121,32 +123,52 @@ std::optional<LocalizerOutput> LocalizerCore::correction_output(const std::strin
 
 std::optional<LocalizerOutput> LocalizerCore::on_range(const std::string& robot_id,
                                                        const RangeMeasurement& range) {
-  Robot* r = robot(robot_id, "range");
-  if (!r) return std::nullopt;
-  r->ranges_silent = false;  // the bus delivers ranges again; whether they fit is the estimator's call
-  const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
-  const InputResult result = r->fusion.update(range);
-  if (!result.accepted) {
-    counts_.reject("range.", *result.rejection);
-    return std::nullopt;
-  }
-  counts_.accept();
-  r->beacons_used.insert(range.beacon_id);
-  return correction_output(robot_id, *r, before);
+  return on_input(robot_id, range);  // none if uses_raw_tof(): the participant does not subscribe then
 }
 
 std::optional<LocalizerOutput> LocalizerCore::on_laser(const std::string& robot_id,
                                                        const LaserScanSample& scan) {
-  if (!uses_laser_) return std::nullopt;  // the participant does not subscribe to scans then
-  Robot* r = robot(robot_id, "laser");
+  return on_input(robot_id, scan);  // none unless uses_laser(): the participant does not subscribe then
+}
+
+std::optional<LocalizerOutput> LocalizerCore::on_raw_tof(const std::string& robot_id, const RawTofSample& tof) {
+  return on_input(robot_id, tof);  // none unless uses_raw_tof(): the participant does not subscribe then
+}
+
+std::optional<LocalizerOutput> LocalizerCore::on_input(const std::string& robot_id, EstimatorInput input) {
+  if (const auto* odometry = std::get_if<OdometrySample>(&input)) return on_odometry(robot_id, *odometry);
+  // What the estimator does not take, the participant does not subscribe to: scans for an
+  // estimator without a laser model; raw TOFs for one of decoded ranges, ranges for one of raw TOFs.
+  if (std::holds_alternative<LaserScanSample>(input) && !uses_laser_) return std::nullopt;
+  if (std::holds_alternative<RawTofSample>(input) && !uses_raw_tof_) return std::nullopt;
+  if (std::holds_alternative<RangeMeasurement>(input) && uses_raw_tof_) return std::nullopt;
+  return on_measurement(robot_id, std::move(input));
+}
+
+namespace {
+// The beacon a measurement is from, for LocalizerOutput::beacons_used; none for a scan.
+std::optional<std::uint32_t> beacon_of(const EstimatorInput& input) {
+  if (const auto* range = std::get_if<RangeMeasurement>(&input)) return range->beacon_id;
+  if (const auto* tof = std::get_if<RawTofSample>(&input)) return tof->beacon_id;
+  return std::nullopt;
+}
+}  // namespace
+
+std::optional<LocalizerOutput> LocalizerCore::on_measurement(const std::string& robot_id, EstimatorInput input) {
+  const std::string kind = kind_name(input);
+  Robot* r = robot(robot_id, kind.c_str());
   if (!r) return std::nullopt;
+  const std::optional<std::uint32_t> beacon = beacon_of(input);
+  // The bus delivers beacon measurements again; whether they fit is the estimator's call.
+  if (beacon) r->ranges_silent = false;
   const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
-  const InputResult result = r->fusion.update_laser(scan);
+  const InputResult result = r->fusion.push(std::move(input));
   if (!result.accepted) {
-    counts_.reject("laser.", *result.rejection);
+    counts_.reject(kind + ".", *result.rejection);
     return std::nullopt;
   }
   counts_.accept();
+  if (beacon) r->beacons_used.insert(*beacon);
   return correction_output(robot_id, *r, before);
 }
 

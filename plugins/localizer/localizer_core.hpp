@@ -48,6 +48,9 @@ class LocalizerCore {
   bool has_beacon_map() const { return !map_.empty(); }
   const BeaconMap& beacon_map() const { return map_; }
   std::uint64_t beacon_map_changes() const { return beacon_map_changes_; }
+  // Any input: odometry to on_odometry; a range, scan or raw TOF fused at its stamp (nothing for
+  // a kind the estimator does not take: see on_range, on_laser, on_raw_tof).
+  std::optional<LocalizerOutput> on_input(const std::string& robot_id, EstimatorInput input);
   // Predicts; returns the pose to publish once the robot's estimator has one.
   std::optional<LocalizerOutput> on_odometry(const std::string& robot_id, const OdometrySample& odometry);
   // Corrects; returns the corrected pose when the measurement changed the estimate, so that it
@@ -59,6 +62,11 @@ class LocalizerCore {
   // Laser scans reach estimators that use them (uses_laser()); others never see one.
   bool uses_laser() const { return uses_laser_; }
   std::optional<LocalizerOutput> on_laser(const std::string& robot_id, const LaserScanSample& scan);
+  // Raw times of flight reach estimators that turn them into ranges themselves (uses_raw_tof(),
+  // seed 002), and are never given decoded ranges; the others are given decoded ranges and never
+  // see a raw TOF.
+  bool uses_raw_tof() const { return uses_raw_tof_; }
+  std::optional<LocalizerOutput> on_raw_tof(const std::string& robot_id, const RawTofSample& tof);
   // Restarts the robot's estimator from a given pose (counted as initial_pose.<reason> if refused).
   void on_initial_pose(const std::string& robot_id, StampNs stamp_ns, const Pose2& pose_map_base,
                        const Cov3& covariance);
@@ -118,6 +126,9 @@ class LocalizerCore {
   Robot* robot(const std::string& robot_id, const char* kind);
   // The robot's pose to publish (none before its first fix), with the beacons fused since the last.
   std::optional<LocalizerOutput> output(const std::string& robot_id, Robot& r);
+  // A range, scan or raw time of flight: fused at its stamp, counted under its kind
+  // ("range.", "laser.", "raw_tof."), the corrected pose returned when it changed.
+  std::optional<LocalizerOutput> on_measurement(const std::string& robot_id, EstimatorInput input);
   std::optional<LocalizerOutput> correction_output(const std::string& robot_id, Robot& r,
                                                    const std::optional<PoseEstimate>& before);
 
@@ -125,6 +136,7 @@ class LocalizerCore {
   EstimatorConfig config_;
   std::string robot_filter_;
   bool uses_laser_ = false;
+  bool uses_raw_tof_ = false;
   BeaconMap map_;
   std::map<std::string, Robot> robots_;
   RejectionCounter counts_;

@@ -18,6 +18,31 @@ StampNs steady_ns() {
 }
 }  // namespace
 
+template <class PubSubType, class Fuse>
+void LocalizerParticipant::subscribe_beacon_measurements(const dds::TopicSpec& topic, Fuse fuse) {
+  using Msg = typename PubSubType::type;
+  dds::ReaderEvents<Msg> events;
+  events.deadline_misses = &deadline_misses_;
+  events.writers_lost = &range_writers_lost_;
+  events.lost_and_none_alive = &range_writer_lost_;
+  events.on_deadline_missed = [this](const Msg& key) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    core_.on_ranges_silent(key.robot_id());
+  };
+  participant_.subscribe<PubSubType>(
+      topic,
+      [this, fuse](const Msg& m) {
+        {
+          // Written under the lock, as every pose is, so that a robot's poses go out in stamp
+          // order: a correction at once, not with the next odometry sample.
+          std::lock_guard<std::mutex> lock(mutex_);
+          if (auto corrected = fuse(m)) publish(*corrected);
+        }
+        ++ranges_processed_;
+      },
+      events);
+}
+
 LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core)
     : core_(std::move(core)),
       conflicts_(std::chrono::duration_cast<std::chrono::nanoseconds>(dds::kDiagnosticsSilentAfter).count()),
@@ -42,29 +67,20 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
         }
       },
       map_events);
-  // A robot whose ranges miss their deadline (two beacon slots) coasts on odometry, degraded.
-  dds::ReaderEvents<msg::BeaconRange> range_events;
-  range_events.deadline_misses = &deadline_misses_;
-  // A decoder that dies or hangs (automatic liveliness, lease 1 s) is reported, not only felt as
-  // silent ranges.
-  range_events.writers_lost = &range_writers_lost_;
-  range_events.lost_and_none_alive = &range_writer_lost_;
-  range_events.on_deadline_missed = [this](const msg::BeaconRange& key) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    core_.on_ranges_silent(key.robot_id());
-  };
-  participant_.subscribe<msg::BeaconRangePubSubType>(
-      dds::kBeaconRangeTopic,
-      [this](const msg::BeaconRange& m) {
-        {
-          // Written under the lock, as every pose is, so that a robot's poses go out in stamp
-          // order: a correction at once, not with the next odometry sample.
-          std::lock_guard<std::mutex> lock(mutex_);
-          if (auto corrected = core_.on_range(m.robot_id(), dds::from_msg(m))) publish(*corrected);
-        }
-        ++ranges_processed_;
-      },
-      range_events);
+  // The beacon measurements: the decoder's ranges, or for an estimator that turns times of flight
+  // into ranges itself (it estimates the speed of sound, seed 002) the gateway's raw TOFs; never
+  // both. A robot whose measurements miss their deadline (two beacon slots) coasts on odometry,
+  // degraded; a writer that dies or hangs (liveliness, lease 1 s) is reported, not only felt as
+  // silence.
+  if (core_.uses_raw_tof()) {
+    subscribe_beacon_measurements<msg::RawTofPubSubType>(dds::kRawTofTopic, [this](const msg::RawTof& m) {
+      return core_.on_raw_tof(m.robot_id(), dds::from_msg(m));
+    });
+  } else {
+    subscribe_beacon_measurements<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic, [this](const msg::BeaconRange& m) {
+      return core_.on_range(m.robot_id(), dds::from_msg(m));
+    });
+  }
   // The gateway's odometry writer: liveliness tells a dead gateway from a robot standing still.
   dds::ReaderEvents<msg::Odometry> odometry_events;
   odometry_events.deadline_misses = &deadline_misses_;

@@ -41,6 +41,10 @@ class LocalizerParticipant {
   void on_odometry(const msg::Odometry& odometry);
   void publish(const LocalizerOutput& out);  // under mutex_
   void on_peer_diagnostics(const msg::Diagnostics& d, const std::string& writer);
+  // Subscribes to the topic the robots' beacon measurements come on (beacon_range, or raw_tof),
+  // with its deadline and liveliness events; fuse gives a sample to the core under mutex_.
+  template <class PubSubType, class Fuse>
+  void subscribe_beacon_measurements(const dds::TopicSpec& topic, Fuse fuse);
 
   std::mutex mutex_;
   LocalizerCore core_;
@@ -57,7 +61,7 @@ class LocalizerParticipant {
   std::uint64_t lost_increments_ = 0;    // sequence numbers never received
   std::uint64_t sequence_restarts_ = 0;  // jumps beyond kSequenceRestart
   std::atomic<bool> odometry_writer_lost_{false};           // lost, none alive since
-  std::atomic<std::uint64_t> range_writers_lost_{0};        // the decoder's beacon_range writer
+  std::atomic<std::uint64_t> range_writers_lost_{0};        // the beacon_range (or raw_tof) writer
   std::atomic<bool> range_writer_lost_{false};              // lost, none alive since
   std::atomic<std::uint64_t> odometry_processed_{0};
   std::atomic<std::uint64_t> ranges_processed_{0};

@@ -11,6 +11,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -258,6 +259,13 @@ void expect_failures_change_nothing(Filter filter) {
             FilterOutcome::kSizeMismatch);
   EXPECT_TRUE(unchanged());
   EXPECT_EQ(filter.predict(DiffDriveMotion(0.4, Eigen::Matrix2d::Identity()), Eigen::Vector2d(std::nan(""), 0.0), 0.1)
+                .outcome,
+            FilterOutcome::kNonFinite);
+  EXPECT_TRUE(unchanged());
+  // An infinite input noise (the filter checks the result it would take, not each factor).
+  EXPECT_EQ(filter
+                .predict(DiffDriveMotion(0.4, std::numeric_limits<double>::infinity() * Eigen::Matrix2d::Identity()),
+                         Eigen::Vector2d(0.1, 0.2), 0.1)
                 .outcome,
             FilterOutcome::kNonFinite);
   EXPECT_TRUE(unchanged());

@@ -280,7 +280,7 @@ class TurnsNonFinite final : public Estimator {
   StampNs stamp_ns_ = 0;
   int samples_ = 0;
 };
-BEACONLOC_REGISTER_ESTIMATOR("test_turns_non_finite", "test only", [](const EstimatorConfig& config) {
+BEACONLOC_REGISTER_ESTIMATOR("test_turns_non_finite", "test only", "", [](const EstimatorConfig& config) {
   ParameterReader(config, "test_turns_non_finite").finish();  // it has none
   return std::make_unique<TurnsNonFinite>();
 });

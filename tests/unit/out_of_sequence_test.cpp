@@ -12,6 +12,7 @@
 #include "offline_run.hpp"
 #include "sim/scenario.hpp"
 #include "sim/scenario_yaml.hpp"
+#include "standing_odometry.hpp"
 
 namespace beaconloc {
 namespace {
@@ -93,13 +94,7 @@ TEST(OutOfSequenceFusion, UkfFusesLateScansAndAnonymousRangesExactlyAsInOrder) {
                           "ukf_lrf", 4.0, 0);
 }
 
-OdometrySample still_odometry(StampNs stamp_ns) {
-  OdometrySample o;
-  o.stamp_ns = stamp_ns;
-  o.wheel_base_m = 0.33;
-  o.wheel_velocity_covariance = 1e-6 * Eigen::Matrix2d::Identity();
-  return o;
-}
+OdometrySample still_odometry(StampNs stamp_ns) { return standing_odometry(stamp_ns, 0.33, 1e-6); }
 
 TEST(OutOfSequenceFusion, RefusesMeasurementsOlderThanTheHorizonOrAheadOfIt) {
   EstimatorConfig config;
@@ -109,18 +104,18 @@ TEST(OutOfSequenceFusion, RefusesMeasurementsOlderThanTheHorizonOrAheadOfIt) {
   OutOfSequenceFusion fusion(EstimatorRegistry::instance().create("range_ekf", config), options);
   fusion.set_beacon_map(BeaconMap(sim::default_scenario().beacons));
   for (StampNs t = 0; t <= 2 * kNsPerSecond; t += 10 * kNsPerMillisecond) {
-    ASSERT_TRUE(fusion.predict(still_odometry(t)).accepted);
+    ASSERT_TRUE(fusion.push(still_odometry(t)).accepted);
   }
   RangeMeasurement r;
   r.beacon_id = sim::default_scenario().beacons.front().id;
   r.range_m = 2.0;
   r.variance_m2 = 1e-4;
   r.stamp_ns = 2 * kNsPerSecond - 700 * kNsPerMillisecond;
-  EXPECT_EQ(fusion.update(r).rejection, Rejection::kTooLate);
+  EXPECT_EQ(fusion.push(r).rejection, Rejection::kTooLate);
   r.stamp_ns = 2 * kNsPerSecond + 700 * kNsPerMillisecond;
-  EXPECT_EQ(fusion.update(r).rejection, Rejection::kAheadOfOdometry);
+  EXPECT_EQ(fusion.push(r).rejection, Rejection::kAheadOfOdometry);
   r.stamp_ns = 2 * kNsPerSecond - 500 * kNsPerMillisecond;
-  EXPECT_TRUE(fusion.update(r).accepted);
+  EXPECT_TRUE(fusion.push(r).accepted);
   EXPECT_EQ(fusion.replays(), 1u);
   EXPECT_GE(fusion.replayed_odometry_steps(), 50u);  // 500 ms of odometry at 100 Hz, replayed
 }
@@ -130,14 +125,14 @@ TEST(OutOfSequenceFusion, ARestartIsNotUndoneByMeasurementsFromBeforeIt) {
   config.receivers = sim::default_scenario().receivers;
   OutOfSequenceFusion fusion(EstimatorRegistry::instance().create("range_ekf", config));
   fusion.set_beacon_map(BeaconMap(sim::default_scenario().beacons));
-  for (StampNs t = 0; t <= kNsPerSecond; t += 10 * kNsPerMillisecond) fusion.predict(still_odometry(t));
+  for (StampNs t = 0; t <= kNsPerSecond; t += 10 * kNsPerMillisecond) fusion.push(still_odometry(t));
   ASSERT_TRUE(fusion.reset(kNsPerSecond, Pose2(1.0, 0.5, 0.2), 1e-4 * Cov3::Identity()).accepted);
   RangeMeasurement r;
   r.beacon_id = sim::default_scenario().beacons.front().id;
   r.range_m = 2.0;
   r.variance_m2 = 1e-4;
   r.stamp_ns = kNsPerSecond - 100 * kNsPerMillisecond;
-  EXPECT_EQ(fusion.update(r).rejection, Rejection::kTooLate);
+  EXPECT_EQ(fusion.push(r).rejection, Rejection::kTooLate);
   EXPECT_EQ(fusion.estimator().estimate()->pose_map_base, Pose2(1.0, 0.5, 0.2));
 }
 
@@ -157,7 +152,7 @@ TEST(OutOfSequenceFusion, APoseGivenBeforeOdometryAgesOnTheRobotsClockNotOnItsSt
       ASSERT_TRUE(fusion.reset(stamp_ns, Pose2(1.0, 0.5, 0.2), 1e-4 * Cov3::Identity()).accepted) << name;
       const StampNs start_ns = 100 * kNsPerSecond;
       for (StampNs t = start_ns; t <= start_ns + 20 * kNsPerSecond; t += 10 * kNsPerMillisecond) {
-        fusion.predict(still_odometry(t));
+        fusion.push(still_odometry(t));
         const auto e = fusion.estimator().estimate();
         ASSERT_TRUE(e) << name << " at " << t;
         EXPECT_LT((e->pose_map_base - Pose2(1.0, 0.5, 0.2)).norm(), 1e-6) << name;

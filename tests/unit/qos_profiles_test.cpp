@@ -7,6 +7,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include <tinyxml2.h>
+
+#include "beaconloc/core/limits.hpp"
 #include "beaconloc/dds/participant.hpp"
 
 namespace beaconloc {
@@ -58,6 +61,34 @@ TEST(QosProfiles, AFileThatRedefinesAProfileIsRefusedNamingIt) {
       write_qos("copy.xml", "  <participant profile_name=\"test.mine\"><rtps/></participant>\n");
   EXPECT_NE(error_of(copy).find("participant 'test.mine' is already defined"), std::string::npos);
   std::filesystem::remove_all(std::filesystem::path(mine).parent_path());
+}
+
+// The horizon is one fact (core/limits.hpp); the QoS file cannot name it, so this holds the raw_tof
+// and beacon_range lifespans, writers and readers, to it.
+TEST(QosProfiles, TheMeasurementLifespansAreTheHorizon) {
+  tinyxml2::XMLDocument doc;
+  const std::string file = std::string(BEACONLOC_SOURCE_DIR) + "/examples/qos/topics.xml";
+  ASSERT_EQ(doc.LoadFile(file.c_str()), tinyxml2::XML_SUCCESS) << file;
+  int checked = 0;
+  const tinyxml2::XMLElement* profiles = doc.RootElement()->FirstChildElement("profiles");
+  ASSERT_NE(profiles, nullptr) << file;
+  for (const tinyxml2::XMLElement* e = profiles->FirstChildElement(); e; e = e->NextSiblingElement()) {
+    const char* name = e->Attribute("profile_name");
+    if (!name) continue;
+    const std::string profile = name;
+    if (profile.rfind("raw_tof.", 0) != 0 && profile.rfind("beacon_range.", 0) != 0) continue;
+    const tinyxml2::XMLElement* qos = e->FirstChildElement("qos");
+    const tinyxml2::XMLElement* lifespan = qos ? qos->FirstChildElement("lifespan") : nullptr;
+    const tinyxml2::XMLElement* duration = lifespan ? lifespan->FirstChildElement("duration") : nullptr;
+    ASSERT_NE(duration, nullptr) << profile << " has no lifespan";
+    const tinyxml2::XMLElement* sec = duration->FirstChildElement("sec");
+    const tinyxml2::XMLElement* nanosec = duration->FirstChildElement("nanosec");
+    ASSERT_TRUE(sec && nanosec) << profile << ": a lifespan without sec and nanosec";
+    const StampNs lifespan_ns = sec->Int64Text() * kNsPerSecond + nanosec->Int64Text();
+    EXPECT_EQ(lifespan_ns, kMeasurementHorizonNs) << profile;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 4);  // raw_tof and beacon_range, writer and reader
 }
 
 }  // namespace

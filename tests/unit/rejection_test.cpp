@@ -11,6 +11,8 @@
 
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/rejection.hpp"
+#include "shipped_estimators.hpp"
+#include "standing_odometry.hpp"
 
 namespace beaconloc {
 namespace {
@@ -28,9 +30,10 @@ TEST(Rejection, EveryReasonHasItsOwnSnakeCaseName) {
 TEST(Rejection, EveryFilterOutcomeHasItsReason) {
   for (FilterOutcome o : {FilterOutcome::kGated, FilterOutcome::kSingularInnovation, FilterOutcome::kNotPositiveDefinite,
                           FilterOutcome::kBoundNotMet, FilterOutcome::kNonFinite, FilterOutcome::kSizeMismatch}) {
-    EXPECT_STREQ(to_string(o), to_string(rejection_for(o)));
+    EXPECT_STREQ(to_string(o), to_string(*rejection_for(o)));
   }
   EXPECT_EQ(rejection_for(FilterOutcome::kGated), Rejection::kGatedNis);
+  EXPECT_EQ(rejection_for(FilterOutcome::kApplied), std::nullopt);
 }
 
 const BeaconMap kMap({{1, {0.0, 0.0, 2.5}, 0}, {2, {3.0, 0.0, 2.5}, 0}, {3, {1.5, 2.0, 2.5}, 0}});
@@ -54,23 +57,7 @@ std::unique_ptr<Estimator> make(const std::string& name) {
   return EstimatorRegistry::instance().create(name, single);
 }
 
-// The estimators the product registers; the test doubles other tests register in this binary
-// (named test_*) are not estimators of a paper.
-std::vector<std::string> shipped_estimators() {
-  std::vector<std::string> out;
-  for (const std::string& name : EstimatorRegistry::instance().names()) {
-    if (name.rfind("test_", 0) != 0) out.push_back(name);
-  }
-  return out;
-}
-
-OdometrySample odometry(StampNs stamp_ns) {
-  OdometrySample o;
-  o.stamp_ns = stamp_ns;
-  o.wheel_base_m = 0.4;
-  o.wheel_velocity_covariance = 1e-4 * Eigen::Matrix2d::Identity();
-  return o;
-}
+OdometrySample odometry(StampNs stamp_ns) { return standing_odometry(stamp_ns); }
 
 TEST(Rejection, TheSameBadRangeGetsTheSameReasonFromEveryEstimator) {
   ASSERT_GE(shipped_estimators().size(), 5u);

@@ -48,22 +48,36 @@ OfflineStack::OfflineStack(const sim::Scenario& scenario, const std::string& est
   decoder.set_beacon_map(BeaconMap(scenario.beacons));
 }
 
+std::optional<EstimatorInput> estimator_input(const std::string& robot_id, const SourceEvent& e,
+                                              TofDecoder& decoder, bool raw_tof) {
+  switch (e.kind) {
+    case SourceEvent::Kind::kOdometry:
+      return e.odometry;
+    case SourceEvent::Kind::kLaserScan:
+      return e.scan;
+    case SourceEvent::Kind::kTof:
+      if (raw_tof) return e.tof;
+      if (auto out = decoder.decode(robot_id, e.tof); out.range) return out.range->range;
+      return std::nullopt;
+    case SourceEvent::Kind::kTruth:
+      return std::nullopt;
+  }
+  return std::nullopt;
+}
+
 std::optional<LocalizerOutput> OfflineStack::feed(const std::string& robot_id, const SourceEvent& e) {
-  if (e.kind == SourceEvent::Kind::kTof) {
-    if (const auto out = decoder.decode(robot_id, e.tof); out.range) {
-      if (e.true_beacon_id != kBeaconUnidentified) range_truth_[out.range->range.stamp_ns] = e.true_beacon_id;
-      // The corrected pose a live localizer publishes at once is not a row here: offline, each
-      // odometry sample's pose is scored, and a correction shows in the next one.
-      localizer.on_range(robot_id, out.range->range);
-    }
+  std::optional<EstimatorInput> input = estimator_input(robot_id, e, decoder, localizer.uses_raw_tof());
+  if (!input) return std::nullopt;
+  if (const auto* range = std::get_if<RangeMeasurement>(&*input); range && e.true_beacon_id != kBeaconUnidentified) {
+    range_truth_[range->stamp_ns] = e.true_beacon_id;
+  }
+  if (!is_odometry(*input)) {
+    // The corrected pose a live localizer publishes at once is not a row here: offline, each
+    // odometry sample's pose is scored, and a correction shows in the next one.
+    localizer.on_input(robot_id, std::move(*input));
     return std::nullopt;
   }
-  if (e.kind == SourceEvent::Kind::kLaserScan) {
-    localizer.on_laser(robot_id, e.scan);
-    return std::nullopt;
-  }
-  if (e.kind != SourceEvent::Kind::kOdometry) return std::nullopt;
-  auto pose = localizer.on_odometry(robot_id, e.odometry);
+  auto pose = localizer.on_input(robot_id, std::move(*input));
   for (const auto& a : localizer.take_associations(robot_id)) {
     const auto truth = range_truth_.find(a.range_stamp_ns);
     if (truth == range_truth_.end()) continue;

@@ -19,6 +19,13 @@ namespace beaconloc {
 // Every event of a scenario up to duration_s, in stamp order.
 std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed, double duration_s);
 
+// What the localizer is given for a source event, as the participants deliver it: odometry and
+// scans as they are; a TOF decoded into a range by `decoder` (nullopt when the decoder refuses
+// it), or the TOF itself for an estimator that uses raw times of flight (raw_tof); nullopt for a
+// truth event.
+std::optional<EstimatorInput> estimator_input(const std::string& robot_id, const SourceEvent& e,
+                                              TofDecoder& decoder, bool raw_tof);
+
 // Anonymous ranges associated with a beacon by the estimator, scored against the simulator's
 // truth (who fired), per true beacon.
 struct AssociationTally {

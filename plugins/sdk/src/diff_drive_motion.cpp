@@ -6,6 +6,13 @@ namespace beaconloc {
 
 DiffDrivePrediction predict_diff_drive(const Pose2& pose, double wheel_velocity_right_mps,
                                        double wheel_velocity_left_mps, double wheel_base_m, double dt_s) {
+  DiffDrivePrediction out = diff_drive_step(pose, wheel_velocity_right_mps, wheel_velocity_left_mps, wheel_base_m, dt_s);
+  out.pose = {pose.x() + out.step.x(), pose.y() + out.step.y(), wrap_angle_rad(pose.z() + out.step.z())};
+  return out;
+}
+
+DiffDrivePrediction diff_drive_step(const Pose2& pose, double wheel_velocity_right_mps, double wheel_velocity_left_mps,
+                                    double wheel_base_m, double dt_s) {
   const double delta_d = dt_s * (wheel_velocity_right_mps + wheel_velocity_left_mps) / 2.0;
   const double delta_phi = dt_s * (wheel_velocity_right_mps - wheel_velocity_left_mps) / wheel_base_m;
   const double heading = pose.z() + delta_phi / 2.0;
@@ -13,7 +20,7 @@ DiffDrivePrediction predict_diff_drive(const Pose2& pose, double wheel_velocity_
 
   DiffDrivePrediction out;
   out.step = {delta_d * c, delta_d * s, delta_phi};
-  out.pose = {pose.x() + out.step.x(), pose.y() + out.step.y(), wrap_angle_rad(pose.z() + out.step.z())};
+  out.pose = pose;
 
   out.jacobian_pose << 1.0, 0.0, -delta_d * s,  //
       0.0, 1.0, delta_d * c,                    //

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <stdexcept>
 
 #include "beaconloc/core/decimal.hpp"
@@ -24,6 +25,23 @@ const char* to_string(PoseStatus s) {
       return "lost";
   }
   return "unknown";
+}
+
+const char* kind_name(const EstimatorInput& input) {
+  constexpr const char* kNames[] = {"odometry", "range", "laser", "raw_tof"};
+  static_assert(std::variant_size_v<EstimatorInput> == std::size(kNames), "a name for every kind of input");
+  return input.valueless_by_exception() ? "unknown" : kNames[input.index()];
+}
+
+InputResult Estimator::push(const EstimatorInput& input) {
+  struct Dispatch {
+    Estimator& e;
+    InputResult operator()(const OdometrySample& o) const { return e.predict(o); }
+    InputResult operator()(const RangeMeasurement& r) const { return e.update(r); }
+    InputResult operator()(const LaserScanSample& s) const { return e.update_laser(s); }
+    InputResult operator()(const RawTofSample& t) const { return e.update_raw_tof(t); }
+  };
+  return std::visit(Dispatch{*this}, input);
 }
 
 bool publishable(const PoseEstimate& e) {
@@ -141,8 +159,8 @@ EstimatorRegistry& EstimatorRegistry::instance() {
 }
 
 bool EstimatorRegistry::add(const std::string& name, const std::string& description,
-                            EstimatorFactory factory) {
-  return entries_.emplace(name, Entry{description, std::move(factory)}).second;
+                            const std::string& reference_scenario, EstimatorFactory factory) {
+  return entries_.emplace(name, Entry{description, reference_scenario, std::move(factory)}).second;
 }
 
 std::unique_ptr<Estimator> EstimatorRegistry::create(const std::string& name,
@@ -165,6 +183,11 @@ std::vector<std::string> EstimatorRegistry::names() const {
 std::string EstimatorRegistry::description(const std::string& name) const {
   auto it = entries_.find(name);
   return it == entries_.end() ? std::string() : it->second.description;
+}
+
+std::string EstimatorRegistry::reference_scenario(const std::string& name) const {
+  auto it = entries_.find(name);
+  return it == entries_.end() ? std::string() : it->second.reference_scenario;
 }
 
 InputResult check_initial_pose(const Pose2& pose, const Cov3& c) {

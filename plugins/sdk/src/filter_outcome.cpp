@@ -5,7 +5,8 @@
 namespace beaconloc {
 
 const char* to_string(FilterOutcome outcome) {
-  return outcome == FilterOutcome::kApplied ? "applied" : to_string(rejection_for(outcome));
+  const std::optional<Rejection> rejection = rejection_for(outcome);
+  return rejection ? to_string(*rejection) : "applied";
 }
 
 }  // namespace beaconloc

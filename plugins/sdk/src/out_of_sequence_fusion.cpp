@@ -27,18 +27,7 @@ void OutOfSequenceFusion::set_beacon_map(const BeaconMap& map) {
 }
 
 InputResult OutOfSequenceFusion::apply(const Event& e) {
-  InputResult result;
-  switch (e.kind) {
-    case Event::Kind::kOdometry:
-      result = estimator_->predict(e.odometry);
-      break;
-    case Event::Kind::kRange:
-      result = estimator_->update(e.range);
-      break;
-    case Event::Kind::kLaser:
-      result = estimator_->update_laser(e.scan);
-      break;
-  }
+  const InputResult result = estimator_->push(e.input);
   collect_outputs();  // before any checkpoint: a copy must not carry reports already passed on
   return result;
 }
@@ -48,22 +37,26 @@ void OutOfSequenceFusion::collect_outputs() {
   for (auto& r : estimator_->take_deferred_rejections()) deferred_rejections_.push_back(std::move(r));
 }
 
-InputResult OutOfSequenceFusion::predict(const OdometrySample& odometry) {
+InputResult OutOfSequenceFusion::push(EstimatorInput input) {
   Event e;
-  e.kind = Event::Kind::kOdometry;
-  e.stamp_ns = odometry.stamp_ns;
-  e.odometry = odometry;
+  e.stamp_ns = stamp_of(input);
+  e.input = std::move(input);
+  return is_odometry(e.input) ? odometry(std::move(e)) : measurement(std::move(e));
+}
+
+InputResult OutOfSequenceFusion::odometry(Event e) {
+  const StampNs stamp_ns = e.stamp_ns;
   const InputResult result = apply(e);
   // Only a sample that moved the estimator's time line is kept: an accepted one, or an
   // odometry_gap, which re-anchors it (a replay must do the same). A refused sample changed
   // nothing (non-finite values, a duplicate, out of order) and must not move the horizon.
   if (!result.accepted && result.rejection != Rejection::kOdometryGap) return result;
-  if (newest_odometry_ns_ && odometry.stamp_ns <= *newest_odometry_ns_) return result;
-  newest_odometry_ns_ = odometry.stamp_ns;
+  if (newest_odometry_ns_ && stamp_ns <= *newest_odometry_ns_) return result;
+  newest_odometry_ns_ = stamp_ns;
   if (placed_before_odometry_) {
     // The time line begins: the pose given before it is the estimator's pose from now on.
     const Placement p = *placed_before_odometry_;
-    reset(odometry.stamp_ns, p.pose_map_base, p.covariance);
+    reset(stamp_ns, p.pose_map_base, p.covariance);
     return result;
   }
   if (odometry_since_checkpoint_ == 0) e.checkpoint = estimator_->clone();
@@ -71,22 +64,6 @@ InputResult OutOfSequenceFusion::predict(const OdometrySample& odometry) {
   history_.push_back(std::move(e));
   forget_before_horizon();
   return result;
-}
-
-InputResult OutOfSequenceFusion::update(const RangeMeasurement& range) {
-  Event e;
-  e.kind = Event::Kind::kRange;
-  e.stamp_ns = range.stamp_ns;
-  e.range = range;
-  return measurement(std::move(e));
-}
-
-InputResult OutOfSequenceFusion::update_laser(const LaserScanSample& scan) {
-  Event e;
-  e.kind = Event::Kind::kLaser;
-  e.stamp_ns = scan.stamp_ns;
-  e.scan = scan;
-  return measurement(std::move(e));
 }
 
 InputResult OutOfSequenceFusion::measurement(Event event) {
@@ -134,7 +111,7 @@ InputResult OutOfSequenceFusion::measurement(Event event) {
     const InputResult r = apply(e);
     if (i == inserted) {
       result = r;
-    } else if (e.kind == Event::Kind::kOdometry) {
+    } else if (is_odometry(e.input)) {
       ++replayed_odometry_steps_;
     }
     if (e.checkpoint) e.checkpoint = estimator_->clone();

@@ -29,6 +29,7 @@ const char* to_string(Rejection r) {
     case Rejection::kNoUsableBeams: return "no_usable_beams";
     case Rejection::kStaleScan: return "stale_scan";
     case Rejection::kLaserUnused: return "laser_unused";
+    case Rejection::kRawTofUnused: return "raw_tof_unused";
     case Rejection::kTooLate: return "too_late";
     case Rejection::kAheadOfOdometry: return "ahead_of_odometry";
     case Rejection::kGatedNis: return "gated_nis";
@@ -54,7 +55,7 @@ const char* to_string(Rejection r) {
   return "unknown";
 }
 
-Rejection rejection_for(FilterOutcome outcome) {
+std::optional<Rejection> rejection_for(FilterOutcome outcome) {
   switch (outcome) {
     case FilterOutcome::kGated: return Rejection::kGatedNis;
     case FilterOutcome::kSingularInnovation: return Rejection::kSingularInnovation;
@@ -62,9 +63,9 @@ Rejection rejection_for(FilterOutcome outcome) {
     case FilterOutcome::kBoundNotMet: return Rejection::kHInfinityBoundNotMet;
     case FilterOutcome::kNonFinite: return Rejection::kNonFiniteModel;
     case FilterOutcome::kSizeMismatch: return Rejection::kSizeMismatch;
-    case FilterOutcome::kApplied: break;
+    case FilterOutcome::kApplied: return std::nullopt;
   }
-  return Rejection::kNonFiniteModel;  // not reached for a refused outcome
+  return Rejection::kNonFiniteModel;  // an outcome outside the enumeration: refused all the same
 }
 
 }  // namespace beaconloc

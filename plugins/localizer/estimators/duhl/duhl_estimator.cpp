@@ -94,7 +94,7 @@ InputResult Duhl::predict(const OdometrySample& o) {
     const PredictResult predicted = ekf_.predict(
         DiffDriveMotion(o.wheel_base_m, u), Eigen::Vector2d(o.wheel_velocity_right_mps, o.wheel_velocity_left_mps),
         step.dt_s);
-    if (!predicted.applied()) return InputResult::refused(predicted.outcome);
+    if (!predicted.applied()) return InputResult::of(predicted.outcome);
   }
   for (auto it = available_.begin(); it != available_.end();) {
     const double z = map().find(it->first)->position_map_m.z() - ring_.height_m;
@@ -142,7 +142,7 @@ InputResult Duhl::update(const RangeMeasurement& r) {
   h(r.receiver_id) = 1.0;
   const UpdateResult result =
       q_filter.update(LinearModel<1, 3>(h, Mat<1, 1>(r.variance_m2)), Vec<1>(r.range_m));
-  if (!result.applied()) return InputResult::refused(result.outcome);
+  if (!result.applied()) return InputResult::of(result.outcome);
   it->second.q = q_filter.state();
   it->second.covariance = q_filter.covariance();
   // This receiver's distance now carries the measurement's own variance (eq. 27), and no longer
@@ -310,9 +310,9 @@ StartupWait UhlLast2::waiting_for() const {
 namespace {
 BEACONLOC_REGISTER_ESTIMATOR(
     "duhl", "seed 000 DUHL: EKF corrected by the UHL pose of the dynamically estimated distances",
-    [](const EstimatorConfig& config) { return std::make_unique<Duhl>(config); });
+    "seed000_trajectory1.yaml", [](const EstimatorConfig& config) { return std::make_unique<Duhl>(config); });
 BEACONLOC_REGISTER_ESTIMATOR("uhl_last2", "seed 000's baseline: UHL on the last two Txs' measured distances",
-                             [](const EstimatorConfig& config) {
+                             "seed000_trajectory1.yaml", [](const EstimatorConfig& config) {
                                return std::make_unique<UhlLast2>(config);
                              });
 }  // namespace

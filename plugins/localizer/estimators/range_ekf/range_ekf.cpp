@@ -75,7 +75,7 @@ InputResult RangeEkf::predict(const OdometrySample& o) {
     // Eq. 14, 16: P = J_f,x P J_f,x^T + J_f,u U J_f,u^T.
     const PredictResult predicted = ekf_.predict(
         motion, Eigen::Vector2d(o.wheel_velocity_right_mps, o.wheel_velocity_left_mps), dt_s);
-    if (!predicted.applied()) return InputResult::refused(predicted.outcome);
+    if (!predicted.applied()) return InputResult::of(predicted.outcome);
   }
   return InputResult::ok();
 }
@@ -117,7 +117,7 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r) {
     case FilterOutcome::kGated:
       break;
     default:
-      return InputResult::refused(result.outcome);
+      return InputResult::of(result.outcome);
   }
   ++consecutive_gated_;
   watch_divergence({true, result.nis});
@@ -308,6 +308,7 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
 namespace {
 BEACONLOC_REGISTER_ESTIMATOR("range_ekf",
                              "EKF on [x, y, yaw]: odometry prediction, one update per range, NIS gating",
+                             "default.yaml",
                              [](const EstimatorConfig& config) {
                                return std::make_unique<RangeEkf>(config);
                              });

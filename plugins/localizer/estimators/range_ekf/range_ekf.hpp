@@ -10,6 +10,7 @@
 
 #include "beaconloc/core/chi_square.hpp"
 #include "beaconloc/core/estimator_base.hpp"
+#include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/filters/ekf.hpp"
 #include "beaconloc/core/solvers/range_pose_solver.hpp"
 
@@ -25,7 +26,8 @@ struct RangeEkfParameters {
   double max_odometry_gap_s = 0.2;  // a longer gap is not integrated (reason odometry_gap)
   double wheel_velocity_variance_floor_m2ps2 = 1e-6;
   int reinitialize_after_gated = 15;   // 5 slots x 3 receivers refused in a row: lost
-  double max_range_age_s = 0.6;        // ranges older than the newest odometry by more: stale
+  // Ranges older than the newest odometry by more are stale.
+  double max_range_age_s = static_cast<double>(kMeasurementHorizonNs) / static_cast<double>(kNsPerSecond);
   double init_retry_interval_s = 0.5;  // data time between two attempts at a global fix
   // A range of the window more than this many sigma off the global fix is dropped as an echo
   // (up to 40 % of them); 0 keeps every range.

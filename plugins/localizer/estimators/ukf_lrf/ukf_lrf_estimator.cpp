@@ -350,15 +350,18 @@ bool UkfLrf::place(const Pose2& pose, const Cov3& covariance) {
 
 namespace {
 BEACONLOC_REGISTER_ESTIMATOR("ukf_lrf", "seed 001 UKF: anonymous beacon ranges and laser scans fused",
+                             "seed001_classroom.yaml",
                              [](const EstimatorConfig& c) {
                                return std::make_unique<UkfLrf>(c, Mode::kFusion);
                              });
 BEACONLOC_REGISTER_ESTIMATOR("ukf_lrf_laser_only", "seed 001 UKF on laser scans alone (the paper's case 5)",
+                             "seed001_classroom.yaml",
                              [](const EstimatorConfig& c) {
                                return std::make_unique<UkfLrf>(c, Mode::kLaserOnly);
                              });
 BEACONLOC_REGISTER_ESTIMATOR("ukf_lrf_beacons_only",
                              "seed 001 UKF on anonymous beacon ranges alone (the paper's case 4)",
+                             "seed001_classroom.yaml",
                              [](const EstimatorConfig& c) {
                                return std::make_unique<UkfLrf>(c, Mode::kBeaconsOnly);
                              });

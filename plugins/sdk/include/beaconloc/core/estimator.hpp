@@ -1,6 +1,6 @@
 #pragma once
-// The estimator plugin API. An estimator is pure maths: it is pushed odometry and ranges
-// (predict / update) and asked for its estimate. It never reads a clock and never includes a
+// The estimator plugin API. An estimator is pure maths: it is pushed inputs (push: odometry to
+// predict, ranges, scans and raw times of flight to update) and asked for its estimate. It never reads a clock and never includes a
 // DDS header, so the same code runs live, in replay and in tests.
 #include <cstdint>
 #include <map>
@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "beaconloc/core/beacon_map.hpp"
+#include "beaconloc/core/estimator_input.hpp"
 #include "beaconloc/core/measurements.hpp"
 #include "beaconloc/core/occupancy_grid.hpp"
 #include "beaconloc/core/pose2.hpp"
@@ -42,8 +43,11 @@ struct InputResult {
   std::optional<Rejection> rejection;  // set exactly when not accepted
   static InputResult ok() { return {}; }
   static InputResult rejected(Rejection reason) { return {false, reason}; }
-  // A filter's update or prediction that was not applied.
-  static InputResult refused(FilterOutcome outcome) { return rejected(rejection_for(outcome)); }
+  // What a filter's update or prediction did: accepted when applied, else its rejection.
+  static InputResult of(FilterOutcome outcome) {
+    const std::optional<Rejection> reason = rejection_for(outcome);
+    return reason ? rejected(*reason) : ok();
+  }
 };
 
 struct EstimatorConfig {
@@ -99,12 +103,22 @@ class Estimator {
   // Whether it finds its pose from the beacons alone; false for one that must be placed
   // (given an initial pose): a restart then places it where it was.
   virtual bool localizes_from_beacons() const { return true; }
+  // The one dispatch on an input's kind (core/estimator_input.hpp): to predict, update,
+  // update_laser or update_raw_tof.
+  InputResult push(const EstimatorInput& input);
   virtual InputResult predict(const OdometrySample& odometry) = 0;
   virtual InputResult update(const RangeMeasurement& range) = 0;
   // Laser scans, for the estimators that use them (uses_laser()); the others are never pushed one.
   virtual bool uses_laser() const { return false; }
   virtual InputResult update_laser(const LaserScanSample& /*scan*/) {
     return InputResult::rejected(Rejection::kLaserUnused);
+  }
+  // Raw times of flight, for the estimators that turn them into ranges themselves (they estimate
+  // the speed of sound, seed 002): the localizer subscribes to RawTof for those
+  // (uses_raw_tof()) and to the decoder's ranges for the others, which are never pushed one.
+  virtual bool uses_raw_tof() const { return false; }
+  virtual InputResult update_raw_tof(const RawTofSample& /*tof*/) {
+    return InputResult::rejected(Rejection::kRawTofUnused);
   }
   // Anonymous ranges the estimator associated with a beacon since last asked (for evaluation
   // against the simulator's truth); empty for estimators that need identified ranges.

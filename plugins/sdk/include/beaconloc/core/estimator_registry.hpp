@@ -23,15 +23,21 @@ class UnknownEstimator : public std::runtime_error {
 class EstimatorRegistry {
  public:
   static EstimatorRegistry& instance();
-  bool add(const std::string& name, const std::string& description, EstimatorFactory factory);
+  // reference_scenario: a file of examples/scenarios/ the estimator is meant for (its paper's
+  // setup), on which the suites that walk every estimator run it (tests/accuracy/
+  // every_estimator_test.cpp, benchmarks/every_estimator_benchmark.cpp); empty for test doubles.
+  bool add(const std::string& name, const std::string& description, const std::string& reference_scenario,
+           EstimatorFactory factory);
   // Throws UnknownEstimator naming the known estimators.
   std::unique_ptr<Estimator> create(const std::string& name, const EstimatorConfig& config) const;
   std::vector<std::string> names() const;
   std::string description(const std::string& name) const;
+  std::string reference_scenario(const std::string& name) const;
 
  private:
   struct Entry {
     std::string description;
+    std::string reference_scenario;
     EstimatorFactory factory;
   };
   std::map<std::string, Entry> entries_;
@@ -42,6 +48,6 @@ class EstimatorRegistry {
 #define BEACONLOC_CONCAT_INNER(a, b) a##b
 #define BEACONLOC_CONCAT(a, b) BEACONLOC_CONCAT_INNER(a, b)
 // Use once per estimator at namespace scope in its .cpp.
-#define BEACONLOC_REGISTER_ESTIMATOR(name, description, factory)        \
-  static const bool BEACONLOC_CONCAT(beaconloc_registered_, __LINE__) = \
-      ::beaconloc::EstimatorRegistry::instance().add(name, description, factory)
+#define BEACONLOC_REGISTER_ESTIMATOR(name, description, reference_scenario, factory) \
+  static const bool BEACONLOC_CONCAT(beaconloc_registered_, __LINE__) =              \
+      ::beaconloc::EstimatorRegistry::instance().add(name, description, reference_scenario, factory)

@@ -2,8 +2,16 @@
 // Physical limits of the robots and sites beaconloc serves, defined once: every number read from
 // a file, an option or the bus that stands for one of these quantities is refused beyond them
 // (with a reason naming the field), so that no absurd value reaches an estimator.
+#include "beaconloc/core/time.hpp"
 
 namespace beaconloc {
+
+// How old a beacon measurement may be and still be fused, against the newest data (ns): three
+// 200 ms beacon slots; an older TOF describes a pose the robot has left (0.34 m/s x 0.6 s =
+// 0.2 m). The decoder's stale TOF age, the out-of-sequence fusion's horizon, range_ekf's stale
+// range age, and the raw_tof and beacon_range lifespans of examples/qos/topics.xml
+// (unit.QosProfiles.TheMeasurementLifespansAreTheHorizon checks the file against it).
+inline constexpr StampNs kMeasurementHorizonNs = 600 * kNsPerMillisecond;
 
 // A wheel's speed over the floor, either way (m/s): odometry rows, simulated trajectories.
 inline constexpr double kMaxWheelSpeedMps = 10.0;

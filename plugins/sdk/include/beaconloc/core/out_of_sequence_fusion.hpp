@@ -26,13 +26,14 @@
 #include <vector>
 
 #include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/limits.hpp"
 
 namespace beaconloc {
 
 struct OutOfSequenceOptions {
-  // How late a measurement may be, against the newest odometry stamp: the raw_tof and
-  // beacon_range lifespan (three 200 ms beacon slots). Older ones are refused (too_late).
-  StampNs horizon_ns = 600 * kNsPerMillisecond;
+  // How late a measurement may be, against the newest odometry stamp (core/limits.hpp). Older
+  // ones are refused (too_late).
+  StampNs horizon_ns = kMeasurementHorizonNs;
   // A checkpoint every this many odometry samples: 5 = 50 ms at 100 Hz, so a replay re-runs at
   // most 4 odometry steps more than it must, and 12 copies cover the horizon.
   int checkpoint_every = 5;
@@ -43,9 +44,9 @@ class OutOfSequenceFusion {
   OutOfSequenceFusion(std::unique_ptr<Estimator> estimator, OutOfSequenceOptions options = {});
 
   void set_beacon_map(const BeaconMap& map);
-  InputResult predict(const OdometrySample& odometry);
-  InputResult update(const RangeMeasurement& range);
-  InputResult update_laser(const LaserScanSample& scan);
+  // Odometry moves the time line on; a measurement (range, scan, raw time of flight) is fused at
+  // its own stamp (stamp_of), or refused too_late / ahead_of_odometry.
+  InputResult push(EstimatorInput input);
   // A restart from a given pose forgets the history: nothing before it is replayed. It takes
   // effect at the estimator's own time (its newest odometry), never at the pose's stamp, which
   // comes from another clock (an operator's, rviz2's): before the first odometry sample the pose
@@ -64,14 +65,11 @@ class OutOfSequenceFusion {
 
  private:
   struct Event {
-    enum class Kind { kOdometry, kRange, kLaser };
-    Kind kind = Kind::kOdometry;
-    StampNs stamp_ns = 0;
-    OdometrySample odometry;
-    RangeMeasurement range;
-    LaserScanSample scan;
+    EstimatorInput input;
+    StampNs stamp_ns = 0;                   // stamp_of(input)
     std::unique_ptr<Estimator> checkpoint;  // the estimator right after this odometry sample
   };
+  InputResult odometry(Event event);
   InputResult measurement(Event event);
   InputResult apply(const Event& event);
   void collect_outputs();

@@ -5,6 +5,7 @@
 // gets the same reason wherever it is checked (core/estimator.hpp check_range_numbers,
 // core/odometry_timeline.hpp check_odometry_numbers).
 #include <cstdint>
+#include <optional>
 #include <ostream>
 
 #include "beaconloc/core/filters/outcome.hpp"
@@ -40,6 +41,7 @@ enum class Rejection : std::uint8_t {
   kNoUsableBeams,
   kStaleScan,
   kLaserUnused,
+  kRawTofUnused,  // a raw time of flight, to an estimator of decoded ranges
   // Out-of-sequence fusion (core/out_of_sequence_fusion.hpp).
   kTooLate,
   kAheadOfOdometry,
@@ -71,7 +73,7 @@ inline constexpr int kRejectionCount = static_cast<int>(Rejection::kTimeJump) + 
 const char* to_string(Rejection r);
 inline std::ostream& operator<<(std::ostream& out, Rejection r) { return out << to_string(r); }
 
-// The rejection a filter's outcome means for the measurement (kApplied is none: not to be asked).
-Rejection rejection_for(FilterOutcome outcome);
+// The rejection a filter's outcome means for the measurement; none for kApplied.
+std::optional<Rejection> rejection_for(FilterOutcome outcome);
 
 }  // namespace beaconloc

@@ -34,37 +34,28 @@ class HInfinityFilter : public LinearizedFilter<N> {
     constexpr int M = Model::kSize;
     UpdateResult result;
     result.iterations = 1;
-    if (const FilterOutcome checked = this->check_measurement(model, z); checked != FilterOutcome::kApplied) {
-      result.outcome = checked;
-      return result;
-    }
     if (!(theta_ >= 0.0) || !std::isfinite(theta_)) {
       result.outcome = FilterOutcome::kNonFinite;
       return result;
     }
-    const MeasurementLinearization<M, N> lin = model.linearize(this->x_);
-    const Mat<M, M> r = model.noise();
-    if (!lin.predicted.allFinite() || !lin.jacobian.allFinite() || !r.allFinite()) {
-      result.outcome = FilterOutcome::kNonFinite;
-      return result;
-    }
-    const Vec<M> innovation = model.residual(z, lin.predicted);
-    const Mat<M, N>& h = lin.jacobian;
-    const InnovationFactor<M> s(h * this->p_ * h.transpose() + r);
-    const InnovationFactor<M> r_factor(r);
+    const auto u = this->linearize_update(model, z);
+    result.outcome = u.outcome;
+    if (!result.applied()) return result;
+    const InnovationFactor<M> r_factor(u.r);
     const Eigen::Index n = this->x_.size();
     const Eigen::LLT<Covariance> p_factor(this->p_);
-    if (!s.ok || !r_factor.ok || p_factor.info() != Eigen::Success) {
-      result.outcome = s.ok && r_factor.ok ? FilterOutcome::kNotPositiveDefinite : FilterOutcome::kSingularInnovation;
+    if (!r_factor.ok() || p_factor.info() != Eigen::Success) {
+      result.outcome = r_factor.ok() ? FilterOutcome::kNotPositiveDefinite : FilterOutcome::kSingularInnovation;
       return result;
     }
-    result.nis = innovation.dot(s.ldlt.solve(innovation));
+    const Mat<M, N>& h = u.h;
+    result.nis = u.s->nis(u.innovation);
     if (!(result.nis <= nis_gate)) {
       result.outcome = FilterOutcome::kGated;
       return result;
     }
     const Covariance identity = Covariance::Identity(n, n);
-    const Mat<M, N> r_inv_h = r_factor.ldlt.solve(h);  // R^-1 H
+    const Mat<M, N> r_inv_h = r_factor.solve(h);  // R^-1 H
     const Covariance information = p_factor.solve(identity) - theta_ * identity + h.transpose() * r_inv_h;
     const Eigen::LLT<Covariance> bound(symmetrized(information));
     if (bound.info() != Eigen::Success) {
@@ -73,7 +64,7 @@ class HInfinityFilter : public LinearizedFilter<N> {
     }
     const Covariance p_up = symmetrized(bound.solve(identity));
     const Mat<N, M> k = p_up * r_inv_h.transpose();  // P_up H^T R^-1
-    this->x_ = this->space_.plus(this->x_, k * innovation);
+    this->x_ = this->space_.plus(this->x_, k * u.innovation);
     this->p_ = p_up;
     return result;
   }

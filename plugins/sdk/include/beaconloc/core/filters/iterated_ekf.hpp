@@ -38,34 +38,24 @@ class IteratedEkf : public LinearizedFilter<N> {
     static_assert(Model::kHasJacobian, "the IEKF linearizes its measurement model: this model has no Jacobian");
     constexpr int M = Model::kSize;
     UpdateResult result;
-    if (const FilterOutcome checked = this->check_measurement(model, z); checked != FilterOutcome::kApplied) {
-      result.outcome = checked;
-      return result;
-    }
     const Mat<M, M> r = model.noise();
-    if (!r.allFinite()) {
-      result.outcome = FilterOutcome::kNonFinite;
-      return result;
-    }
+    result.outcome = this->check_measurement(model, z, r);
+    if (!result.applied()) return result;
     const State x0 = this->x_;
     State xi = x0;
     Mat<N, M> k = Mat<N, M>::Zero(x0.size(), model.size());
     Mat<M, N> h = Mat<M, N>::Zero(model.size(), x0.size());
     for (int i = 0; i < options_.max_iterations; ++i) {
-      const MeasurementLinearization<M, N> lin = model.linearize(xi);
-      if (!lin.predicted.allFinite() || !lin.jacobian.allFinite()) {
-        result.outcome = FilterOutcome::kNonFinite;
-        return result;
-      }
-      h = lin.jacobian;
+      Vec<M> innovation;
+      result.outcome = this->linearize_at(model, z, xi, innovation, h);
+      if (!result.applied()) return result;
       const InnovationFactor<M> s(h * this->p_ * h.transpose() + r);
-      if (!s.ok) {
+      if (!s.ok()) {
         result.outcome = FilterOutcome::kSingularInnovation;
         return result;
       }
-      Vec<M> innovation = model.residual(z, lin.predicted);
       if (i == 0) {
-        result.nis = innovation.dot(s.ldlt.solve(innovation));
+        result.nis = s.nis(innovation);
         if (!(result.nis <= nis_gate)) {
           result.outcome = FilterOutcome::kGated;
           return result;
@@ -73,7 +63,7 @@ class IteratedEkf : public LinearizedFilter<N> {
       } else {
         innovation -= h * this->space_.minus(x0, xi);
       }
-      k = s.ldlt.solve(h * this->p_).transpose();
+      k = this->gain(h, s);
       const State next = this->space_.plus(x0, k * innovation);
       result.iterations = i + 1;
       const double step = this->space_.minus(next, xi).norm();
@@ -84,10 +74,8 @@ class IteratedEkf : public LinearizedFilter<N> {
       }
       if (step <= options_.step_tolerance) break;
     }
-    const Covariance i_kh = Covariance::Identity(xi.size(), xi.size()) - k * h;
-    this->p_ = i_kh * this->p_ * i_kh.transpose() + k * r * k.transpose();
-    this->p_ = symmetrized(this->p_);
     this->x_ = xi;
+    this->joseph_update(k, h, r);
     return result;
   }
 

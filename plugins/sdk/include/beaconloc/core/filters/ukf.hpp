@@ -73,16 +73,10 @@ class Ukf : public GaussianFilter<N> {
                       double nis_gate = std::numeric_limits<double>::infinity()) {
     UpdateResult result;
     result.iterations = 1;
-    if (const FilterOutcome checked = this->check_measurement(model, z); checked != FilterOutcome::kApplied) {
-      result.outcome = checked;
-      return result;
-    }
-    const Eigen::Index n = this->x_.size(), m = model.size();
     const Eigen::MatrixXd r = model.noise();
-    if (!r.allFinite()) {
-      result.outcome = FilterOutcome::kNonFinite;
-      return result;
-    }
+    result.outcome = this->check_measurement(model, z, r);
+    if (!result.applied()) return result;
+    const Eigen::Index n = this->x_.size(), m = model.size();
     const bool augmented = options_.augment_measurement_noise;
     const Eigen::Index l = augmented ? n + m : n;
     if (!defined_for(l)) {
@@ -135,18 +129,18 @@ class Ukf : public GaussianFilter<N> {
     Eigen::MatrixXd s = weighted_cross_covariance(z_centred, z_centred, w);
     if (!augmented) s += r;
     const Eigen::MatrixXd xz = weighted_cross_covariance(x_centred, z_centred, w);
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(s);
-    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().array() > 0.0).all()) {
+    const InnovationFactor<Eigen::Dynamic> factor(s);
+    if (!factor.ok()) {
       result.outcome = FilterOutcome::kSingularInnovation;
       return result;
     }
     const Eigen::VectorXd innovation = model.residual(z, z_mean);
-    result.nis = innovation.dot(ldlt.solve(innovation));
+    result.nis = factor.nis(innovation);
     if (!(result.nis <= nis_gate)) {
       result.outcome = FilterOutcome::kGated;
       return result;
     }
-    const Eigen::MatrixXd k = ldlt.solve(xz.transpose()).transpose();
+    const Eigen::MatrixXd k = factor.solve(xz.transpose()).transpose();
     const Covariance p = symmetrized(Covariance(this->p_ - k * s * k.transpose()));
     if (Eigen::LLT<Covariance>(p).info() != Eigen::Success) {
       result.outcome = FilterOutcome::kNotPositiveDefinite;

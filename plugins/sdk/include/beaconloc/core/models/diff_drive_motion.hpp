@@ -8,7 +8,7 @@
 namespace beaconloc {
 
 struct DiffDrivePrediction {
-  Pose2 pose;                                   // x_bar_k of eq. 14
+  Pose2 pose;                                   // x_bar_k of eq. 14 (diff_drive_step: the pose given)
   Eigen::Matrix3d jacobian_pose;                // J_f,x of eq. 16
   Eigen::Matrix<double, 3, 2> jacobian_wheels;  // J_f,u of eq. 16, u = [v_R, v_L]
   Pose2 step;                                   // x_bar_k - x_k-1 (the heading step unwrapped)
@@ -21,6 +21,10 @@ struct DiffDrivePrediction {
 // prints the second factor with "R").
 DiffDrivePrediction predict_diff_drive(const Pose2& pose, double wheel_velocity_right_mps,
                                        double wheel_velocity_left_mps, double wheel_base_m, double dt_s);
+// The same without the moved pose (pose is left as given): the step and the Jacobians, all a
+// filter composing x (+) dx needs (it wraps the heading itself: one wrap, not two).
+DiffDrivePrediction diff_drive_step(const Pose2& pose, double wheel_velocity_right_mps, double wheel_velocity_left_mps,
+                                    double wheel_base_m, double dt_s);
 
 // Eq. 14 and 16 as a motion model (core/models/model_concepts.hpp) on any state holding the pose
 // at `pose`; the rest of the state stays. Input u = [v_R, v_L] (m/s), its noise U_k of eq. 16
@@ -37,13 +41,21 @@ class DiffDriveMotion {
   template <int N>
   Vec<N> step(const Vec<N>& x, const Input& u, double dt_s) const {
     Vec<N> dx = Vec<N>::Zero(x.size());
-    place(dx, predict_diff_drive(pose_.pose_of(x), u(0), u(1), wheel_base_m_, dt_s).step);
+    place(dx, diff_drive_step(pose_.pose_of(x), u(0), u(1), wheel_base_m_, dt_s).step);
     return dx;
   }
   template <int N>
   MotionLinearization<N, 2> linearize(const Vec<N>& x, const Input& u, double dt_s) const {
-    const DiffDrivePrediction p = predict_diff_drive(pose_.pose_of(x), u(0), u(1), wheel_base_m_, dt_s);
+    const DiffDrivePrediction p = diff_drive_step(pose_.pose_of(x), u(0), u(1), wheel_base_m_, dt_s);
     MotionLinearization<N, 2> out;
+    if constexpr (N == 3) {
+      if (pose_.x == 0 && pose_.y == 1 && pose_.yaw == 2) {  // the state is the pose: eq. 16 as it is
+        out.step = p.step;
+        out.jacobian_state = p.jacobian_pose;
+        out.jacobian_input = p.jacobian_wheels;
+        return out;
+      }
+    }
     out.step = Vec<N>::Zero(x.size());
     place(out.step, p.step);
     out.jacobian_state = Mat<N, N>::Identity(x.size(), x.size());

@@ -43,10 +43,4 @@ struct MotionLinearization {
   Mat<N, U> jacobian_input;  // G = d(x (+) dx)/du
 };
 
-// Whether every number of a matrix or vector is finite.
-template <class Derived>
-bool all_finite(const Eigen::MatrixBase<Derived>& m) {
-  return m.allFinite();
-}
-
 }  // namespace beaconloc

@@ -59,7 +59,7 @@ void BM_UkfLrf_Predict(benchmark::State& state) {
       bench::find_snapshot("ukf_lrf", u.config, u.map, u.inputs, 10.0,
                            [](const Estimator&, const std::vector<Input>& in, std::size_t k) {
                              std::optional<std::vector<Input>> step = bench::next_step(in, k);
-                             if (in[k].kind != Input::Kind::kScan || step->size() != 1) step.reset();
+                             if (!in[k].is<LaserScanSample>() || step->size() != 1) step.reset();
                              return step;
                            });
   bench::require_accepted(snapshot, "BM_UkfLrf_Predict");
@@ -74,8 +74,8 @@ void BM_UkfLrf_LaserUpdate(benchmark::State& state) {
       "ukf_lrf", u.config, u.map, u.inputs, 10.0,
       [&](const Estimator&, const std::vector<Input>& in,
           std::size_t k) -> std::optional<std::vector<Input>> {
-        if (in[k].kind != Input::Kind::kOdometry || k + 1 >= in.size() ||
-            in[k + 1].kind != Input::Kind::kScan || usable_beams(in[k + 1].scan) != beams)
+        if (!in[k].is<OdometrySample>() || k + 1 >= in.size() ||
+            !in[k + 1].is<LaserScanSample>() || usable_beams(in[k + 1].as<LaserScanSample>()) != beams)
           return std::nullopt;
         return std::vector<Input>{in[k + 1]};
       });
@@ -95,13 +95,13 @@ void BM_UkfLrf_FusedUpdate(benchmark::State& state) {
                                std::size_t k) -> std::optional<std::vector<Input>> {
                              // Right after a scan was fused; the next odometry step's scan follows that
                              // odometry.
-                             if (in[k].kind != Input::Kind::kScan) return std::nullopt;
+                             if (!in[k].is<LaserScanSample>()) return std::nullopt;
                              std::vector<Input> step = bench::next_step(in, k);
                              const std::size_t next = k + step.size() + 1;
-                             if (step.empty() || next >= in.size() || in[next].kind != Input::Kind::kScan ||
-                                 usable_beams(in[next].scan) != beams)
+                             if (step.empty() || next >= in.size() || !in[next].is<LaserScanSample>() ||
+                                 usable_beams(in[next].as<LaserScanSample>()) != beams)
                                return std::nullopt;
-                             const std::size_t sim_ranges = bench::count(step, Input::Kind::kRange);
+                             const std::size_t sim_ranges = bench::count<RangeMeasurement>(step);
                              if (sim_ranges != (ranges == 1 ? 1u : 0u) || step.size() != sim_ranges + 1)
                                return std::nullopt;
                              const Input odometry = step.back();
@@ -113,17 +113,16 @@ void BM_UkfLrf_FusedUpdate(benchmark::State& state) {
                                std::normal_distribution<double> noise(0.0, u.scenario.range_sigma_m);
                                const ReceiverArray& rx = u.scenario.receivers;
                                for (const Beacon& b : u.scenario.beacons) {
-                                 Input r;
-                                 r.kind = Input::Kind::kRange;
-                                 r.stamp_ns = odometry.stamp_ns;
-                                 r.range.stamp_ns = odometry.stamp_ns;
-                                 r.range.receiver_id = 0;
-                                 r.range.range_m = predict_range(odometry.truth, rx.receivers_base_m[0],
+                                 const StampNs stamp_ns = stamp_of(odometry.input);
+                                 RangeMeasurement r;
+                                 r.stamp_ns = stamp_ns;
+                                 r.receiver_id = 0;
+                                 r.range_m = predict_range(odometry.truth, rx.receivers_base_m[0],
                                                                  rx.receiver_height_m, b.position_map_m)
                                                        .range_m +
                                                    noise(rng);
-                                 r.range.variance_m2 = u.scenario.range_sigma_m * u.scenario.range_sigma_m;
-                                 step.push_back(r);
+                                 r.variance_m2 = u.scenario.range_sigma_m * u.scenario.range_sigma_m;
+                                 step.push_back({r, odometry.truth});
                                }
                              }
                              step.push_back(in[next]);  // the scan, held (stamped after the filter's time)

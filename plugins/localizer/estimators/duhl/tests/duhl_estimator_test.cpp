@@ -1,6 +1,6 @@
 // The duhl and uhl_last2 estimators: registered by name, refusing a robot without the receiver
 // ring of seed 000 eq. 1; a Tx estimate its own measurement contradicts is discarded and started
-// anew. (Their accuracy against Table II: tests/accuracy/duhl_table2_test.cpp.)
+// anew. (Their accuracy against Table II: duhl/accuracy/duhl_table2_test.cpp.)
 #include "duhl/duhl_estimator.hpp"
 
 #include <gtest/gtest.h>

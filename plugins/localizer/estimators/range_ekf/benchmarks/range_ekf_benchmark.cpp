@@ -29,7 +29,7 @@ const RangeEkfScene& range_ekf_scene() {
         bench::find_snapshot("range_ekf", config, map, inputs, 10.0,
                              [](const Estimator& e, const std::vector<Input>& in, std::size_t k) {
                                std::optional<std::vector<Input>> step = bench::next_step(in, k);
-                               if (in[k].kind != Input::Kind::kOdometry || !e.estimate() || step->size() != 1)
+                               if (!in[k].is<OdometrySample>() || !e.estimate() || step->size() != 1)
                                  step.reset();
                                return step;
                              });
@@ -37,8 +37,8 @@ const RangeEkfScene& range_ekf_scene() {
                                      [](const Estimator& e, const std::vector<Input>& in, std::size_t k) {
                                        std::optional<std::vector<Input>> step;
                                        // The first range of a firing, right after an odometry step.
-                                       if (in[k].kind == Input::Kind::kOdometry && e.estimate() &&
-                                           k + 1 < in.size() && in[k + 1].kind == Input::Kind::kRange)
+                                       if (in[k].is<OdometrySample>() && e.estimate() &&
+                                           k + 1 < in.size() && in[k + 1].is<RangeMeasurement>())
                                          step = std::vector<Input>{in[k + 1]};
                                        return step;
                                      });

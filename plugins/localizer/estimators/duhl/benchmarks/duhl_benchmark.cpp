@@ -72,7 +72,7 @@ const DuhlScene& scene(int n) {
       "duhl", config, map, inputs, 10.0,
       [&](const Estimator& e, const std::vector<Input>& in, std::size_t k) {
         std::optional<std::vector<Input>> step = bench::next_step(in, k);
-        if (in[k].kind != Input::Kind::kOdometry || !e.estimate() || available(e) != txs || step->size() != 1)
+        if (!in[k].is<OdometrySample>() || !e.estimate() || available(e) != txs || step->size() != 1)
           step.reset();
         return step;
       });
@@ -81,14 +81,14 @@ const DuhlScene& scene(int n) {
       [&](const Estimator& e, const std::vector<Input>& in,
           std::size_t k) -> std::optional<std::vector<Input>> {
         const std::vector<Input> step = bench::next_step(in, k);
-        if (in[k].kind != Input::Kind::kOdometry || !e.estimate() || available(e) != txs ||
-            step.size() != 4 || bench::count(step, Input::Kind::kRange) != 3 ||
-            step[0].range.beacon_id != step[2].range.beacon_id)
+        if (!in[k].is<OdometrySample>() || !e.estimate() || available(e) != txs ||
+            step.size() != 4 || bench::count<RangeMeasurement>(step) != 3 ||
+            step[0].as<RangeMeasurement>().beacon_id != step[2].as<RangeMeasurement>().beacon_id)
           return std::nullopt;
         // The correction applied (not gated), on the N Txs.
         auto predicted = e.clone(), corrected = e.clone();
-        predicted->predict(step.back().odometry);
-        for (const Input& input : step) bench::push(*corrected, input);
+        predicted->push(step.back().input);
+        for (const Input& input : step) corrected->push(input.input);
         if (available(*corrected) != txs || !(trace(*corrected) < trace(*predicted))) return std::nullopt;
         return step;
       });
@@ -150,4 +150,3 @@ BENCHMARK(BM_Uhl)->Arg(6)->Arg(10);
 }  // namespace
 }  // namespace beaconloc
 
-BENCHMARK_MAIN();

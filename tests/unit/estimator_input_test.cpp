@@ -1,0 +1,145 @@
+// The one input type (core/estimator_input.hpp): Estimator::push dispatches each kind to its
+// method, the out-of-sequence fusion orders every kind by stamp_of, and the localizer core gives
+// raw times of flight only to the estimators that use them, counting their rejections under
+// "raw_tof.".
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/estimator_registry.hpp"
+#include "beaconloc/core/out_of_sequence_fusion.hpp"
+#include "localizer_core.hpp"
+#include "standing_odometry.hpp"
+
+namespace beaconloc {
+namespace {
+
+// Writes down every call, in order: "odometry@<stamp>", "range@<stamp>", "laser@<stamp>",
+// "raw_tof@<fire stamp>". Refuses a raw TOF of tof_s < 0 (negative_tof), as an estimator of raw
+// TOFs would; takes laser scans and raw TOFs.
+class RecordingEstimator : public Estimator {
+ public:
+  std::string name() const override { return "test_recording"; }
+  void set_beacon_map(const BeaconMap&) override {}
+  bool uses_laser() const override { return true; }
+  bool uses_raw_tof() const override { return true; }
+  InputResult predict(const OdometrySample& o) override { return note("odometry", o.stamp_ns); }
+  InputResult update(const RangeMeasurement& r) override { return note("range", r.stamp_ns); }
+  InputResult update_laser(const LaserScanSample& s) override { return note("laser", s.stamp_ns); }
+  InputResult update_raw_tof(const RawTofSample& t) override {
+    if (t.tof_s < 0.0) return InputResult::rejected(Rejection::kNegativeTof);
+    return note("raw_tof", t.fire_stamp_ns);
+  }
+  std::optional<PoseEstimate> estimate() const override {
+    PoseEstimate e;
+    e.stamp_ns = static_cast<StampNs>(calls.size());  // changes with every call: a correction shows
+    e.status = PoseStatus::kOk;
+    return e;
+  }
+  PoseStatus status() const override { return PoseStatus::kOk; }
+  std::optional<StartupWait> startup_wait() const override { return std::nullopt; }
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<RecordingEstimator>(*this); }
+
+  std::vector<std::string> calls;
+
+ private:
+  InputResult note(const char* what, StampNs stamp_ns) {
+    calls.push_back(std::string(what) + "@" + std::to_string(stamp_ns));
+    return InputResult::ok();
+  }
+};
+
+BEACONLOC_REGISTER_ESTIMATOR("test_recording", "test double: records the inputs it is pushed", "",
+                             [](const EstimatorConfig&) { return std::make_unique<RecordingEstimator>(); });
+
+OdometrySample odometry_at(StampNs stamp_ns) { return standing_odometry(stamp_ns); }
+RangeMeasurement range_at(StampNs stamp_ns) {
+  RangeMeasurement r;
+  r.stamp_ns = stamp_ns;
+  r.beacon_id = 7;
+  r.range_m = 2.0;
+  r.variance_m2 = 1e-4;
+  return r;
+}
+LaserScanSample scan_at(StampNs stamp_ns) {
+  LaserScanSample s;
+  s.stamp_ns = stamp_ns;
+  return s;
+}
+RawTofSample tof_fired_at(StampNs fire_stamp_ns, double tof_s = 0.006) {
+  RawTofSample t;
+  t.beacon_id = 9;
+  t.fire_stamp_ns = fire_stamp_ns;
+  t.tof_s = tof_s;
+  return t;
+}
+
+TEST(EstimatorInput, PushGivesEachKindToItsMethod) {
+  RecordingEstimator e;
+  for (const EstimatorInput& in : std::vector<EstimatorInput>{odometry_at(1), range_at(2), scan_at(3), tof_fired_at(4)}) {
+    EXPECT_TRUE(e.push(in).accepted);
+  }
+  EXPECT_EQ(e.calls, (std::vector<std::string>{"odometry@1", "range@2", "laser@3", "raw_tof@4"}));
+  EXPECT_EQ(e.push(tof_fired_at(5, -1.0)).rejection, Rejection::kNegativeTof);
+}
+
+TEST(EstimatorInput, KindsAreNamedAndStampedOnce) {
+  EXPECT_STREQ(kind_name(odometry_at(1)), "odometry");
+  EXPECT_STREQ(kind_name(range_at(1)), "range");
+  EXPECT_STREQ(kind_name(scan_at(1)), "laser");
+  EXPECT_STREQ(kind_name(tof_fired_at(1)), "raw_tof");
+  EXPECT_EQ(stamp_of(odometry_at(11)), 11);
+  EXPECT_EQ(stamp_of(range_at(12)), 12);
+  EXPECT_EQ(stamp_of(scan_at(13)), 13);
+  EXPECT_EQ(stamp_of(tof_fired_at(14)), 14);  // the firing; the arrival needs the speed of sound
+  EXPECT_TRUE(is_odometry(odometry_at(1)));
+  EXPECT_FALSE(is_odometry(tof_fired_at(1)));
+}
+
+TEST(EstimatorInput, AnEstimatorOfDecodedRangesRefusesARawTof) {
+  EstimatorConfig config;
+  config.receivers = ReceiverArray::on_circle(0.19, 3);
+  const auto e = EstimatorRegistry::instance().create("range_ekf", config);
+  EXPECT_FALSE(e->uses_raw_tof());
+  EXPECT_EQ(e->push(tof_fired_at(1)).rejection, Rejection::kRawTofUnused);
+}
+
+TEST(EstimatorInput, ALateRawTofIsReplayedAtItsStampAmongTheOtherKinds) {
+  OutOfSequenceFusion fusion(std::make_unique<RecordingEstimator>());
+  const StampNs ms = kNsPerMillisecond;
+  for (StampNs t = 0; t <= 50 * ms; t += 10 * ms) ASSERT_TRUE(fusion.push(odometry_at(t)).accepted);
+  ASSERT_TRUE(fusion.push(scan_at(45 * ms)).accepted);
+  ASSERT_TRUE(fusion.push(tof_fired_at(25 * ms)).accepted);  // late: before the scan and two odometry samples
+  ASSERT_TRUE(fusion.push(range_at(35 * ms)).accepted);
+  const auto& calls = dynamic_cast<const RecordingEstimator&>(fusion.estimator()).calls;
+  const std::vector<std::string> in_stamp_order{"odometry@0",        "odometry@10000000", "odometry@20000000",
+                                                "raw_tof@25000000",  "odometry@30000000", "range@35000000",
+                                                "odometry@40000000", "laser@45000000",    "odometry@50000000"};
+  EXPECT_EQ(calls, in_stamp_order);
+  EXPECT_EQ(fusion.push(tof_fired_at(-700 * ms)).rejection, Rejection::kTooLate);
+}
+
+TEST(EstimatorInput, TheLocalizerGivesRawTofsOnlyToEstimatorsThatUseThemAndThemNoRanges) {
+  EstimatorConfig config;
+  config.receivers = ReceiverArray::on_circle(0.19, 3);
+  LocalizerCore raw("test_recording", config);
+  ASSERT_TRUE(raw.uses_raw_tof());
+  raw.on_odometry("r", odometry_at(0));
+  EXPECT_TRUE(raw.on_raw_tof("r", tof_fired_at(5)).has_value());  // fused: the corrected pose goes out
+  EXPECT_FALSE(raw.on_raw_tof("r", tof_fired_at(6, -1.0)).has_value());
+  EXPECT_EQ(raw.counts().rejected("raw_tof.negative_tof"), 1u);
+  // ... and never the decoder's ranges of the same pulses: each pulse reaches it once.
+  EXPECT_FALSE(raw.on_range("r", range_at(7)).has_value());
+  EXPECT_FALSE(raw.on_input("r", range_at(8)).has_value());
+  EXPECT_EQ(raw.counts().accepted(), 2u);  // the odometry sample and the one good raw TOF
+
+  LocalizerCore ranges("range_ekf", config);
+  EXPECT_FALSE(ranges.uses_raw_tof());
+  ranges.on_odometry("r", odometry_at(0));
+  EXPECT_FALSE(ranges.on_raw_tof("r", tof_fired_at(5)).has_value());  // never subscribed: never given one
+  EXPECT_EQ(ranges.counts().rejected("raw_tof.raw_tof_unused"), 0u);
+}
+
+}  // namespace
+}  // namespace beaconloc
