@@ -179,6 +179,19 @@ TEST(StackedModel, RangesAndAPoseObservationStackTheirHJacobianNoiseAndResiduals
   EXPECT_NEAR(res(4), 2.0 * M_PI - 6.2, 1e-12);
 }
 
+TEST(MeasurementModels, OnlyModelsWithoutAnAngleSayTheirResidualIsThePlainDifference) {
+  static_assert(plain_residual_v<RangeModel> && plain_residual_v<RangeDifferenceModel> &&
+                    plain_residual_v<ArrivalTimeModel> && plain_residual_v<LaserBeamModel>,
+                "");
+  static_assert(!plain_residual_v<PoseObservationModel>, "its residual wraps the heading");
+  static_assert(plain_residual_v<StackedModel<ModelList<RangeModel>, LaserBeamModel>>, "");
+  static_assert(!plain_residual_v<StackedModel<ModelList<RangeModel>, PoseObservationModel>>, "");
+  static_assert(!plain_residual_v<ModelList<PoseObservationModel>>, "");
+  // And the one that says so computes it: z - h, whatever the numbers.
+  const RangeModel range({0.0, 0.0}, 0.0, {1.0, 1.0, 2.5}, 0.16);
+  EXPECT_EQ(range.residual(Vec<1>(-3.5), Vec<1>(3.5))(0), -7.0);
+}
+
 TEST(StackedModel, WithoutAJacobianInAPartTheStackHasNone) {
   static_assert(!StackedModel<ModelList<RangeModel>, LaserBeamModel>::kHasJacobian, "");
   static_assert(ModelList<RangeModel>::kHasJacobian, "");

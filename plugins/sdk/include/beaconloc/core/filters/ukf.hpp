@@ -179,16 +179,22 @@ class Ukf : public GaussianFilter<N> {
       return result;
     }
     if (augmented) z_sigma += points.measurement_noise_;  // seed 001 eq. 16: + chi_n
-    // The measurement's mean as offsets from the first point (angle-aware through the residual).
-    const typename Model::Vector z0 = z_sigma.col(0);
-    Eigen::MatrixXd z_offsets(m, count);
-    for (Eigen::Index i = 0; i < count; ++i) {
-      z_offsets.col(i) = model.residual(typename Model::Vector(z_sigma.col(i)), z0);
-    }
-    const typename Model::Vector z_mean = z0 + typename Model::Vector(weighted_mean(z_offsets, w));
+    typename Model::Vector z_mean;
     Eigen::MatrixXd z_centred(m, count);
-    for (Eigen::Index i = 0; i < count; ++i) {
-      z_centred.col(i) = model.residual(typename Model::Vector(z_sigma.col(i)), z_mean);
+    if constexpr (plain_residual_v<Model>) {
+      z_mean = weighted_mean(z_sigma, w);  // eq. 18
+      z_centred = z_sigma.colwise() - Eigen::VectorXd(z_mean);
+    } else {
+      // The mean as offsets from the first point (angle-aware through the residual).
+      const typename Model::Vector z0 = z_sigma.col(0);
+      Eigen::MatrixXd z_offsets(m, count);
+      for (Eigen::Index i = 0; i < count; ++i) {
+        z_offsets.col(i) = model.residual(typename Model::Vector(z_sigma.col(i)), z0);
+      }
+      z_mean = z0 + typename Model::Vector(weighted_mean(z_offsets, w));
+      for (Eigen::Index i = 0; i < count; ++i) {
+        z_centred.col(i) = model.residual(typename Model::Vector(z_sigma.col(i)), z_mean);
+      }
     }
     Eigen::MatrixXd x_centred(n, count);
     for (Eigen::Index i = 0; i < count; ++i) {

@@ -33,6 +33,7 @@ class LaserBeamModel {
  public:
   static constexpr int kSize = Eigen::Dynamic;
   static constexpr bool kHasJacobian = false;
+  static constexpr bool kPlainResidual = true;  // z - h: no angle in z
   using Vector = Eigen::VectorXd;
 
   LaserBeamModel(std::shared_ptr<const OccupancyGrid> grid, LaserBeams beams, double beam_variance_m2,

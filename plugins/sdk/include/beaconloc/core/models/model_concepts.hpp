@@ -12,6 +12,9 @@
 //       linearize(const Vec<N>& x) const;                       // h(x) and dh/dx (kHasJacobian)
 //   Mat<kSize, kSize> noise() const;                            // R
 //   Vector residual(const Vector& z, const Vector& h) const;    // z - h, angles wrapped
+//   static constexpr bool kPlainResidual;  // optional: true when residual() is z - h exactly
+//                                          // (no angle in z); the UKF then centres its sigma
+//                                          // points' predictions at once, not one call per point
 //
 // A motion model moves a state by an input u over dt_s. It gives the step dx, and the filter
 // composes x (+) dx in its state space (core/filters/state_space.hpp), so that headings are
@@ -26,9 +29,20 @@
 //   template <int N> Mat<N, N> state_noise(Eigen::Index n, double dt_s) const;        // Q, when kHasStateNoise
 // The EKF's predicted covariance is F P F^T + G U G^T (+ Q); the UKF propagates sigma points of
 // the state augmented with the input noise.
+#include <type_traits>
+
 #include "beaconloc/core/filters/state_space.hpp"
 
 namespace beaconloc {
+
+// Model::kPlainResidual, false for a model that does not say.
+template <class Model, class = void>
+struct PlainResidual : std::false_type {};
+template <class Model>
+struct PlainResidual<Model, std::void_t<decltype(Model::kPlainResidual)>>
+    : std::bool_constant<Model::kPlainResidual> {};
+template <class Model>
+inline constexpr bool plain_residual_v = PlainResidual<Model>::value;
 
 template <int M, int N>
 struct MeasurementLinearization {

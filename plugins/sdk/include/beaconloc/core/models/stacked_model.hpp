@@ -18,6 +18,7 @@ class ModelList {
  public:
   static constexpr int kSize = Eigen::Dynamic;
   static constexpr bool kHasJacobian = Part::kHasJacobian;
+  static constexpr bool kPlainResidual = plain_residual_v<Part>;
   using Vector = Eigen::VectorXd;
 
   ModelList() = default;
@@ -90,6 +91,7 @@ class StackedModel {
  public:
   static constexpr int kSize = Eigen::Dynamic;
   static constexpr bool kHasJacobian = A::kHasJacobian && B::kHasJacobian;
+  static constexpr bool kPlainResidual = plain_residual_v<A> && plain_residual_v<B>;
   using Vector = Eigen::VectorXd;
 
   StackedModel(A first, B second) : first_(std::move(first)), second_(std::move(second)) {}
