@@ -171,7 +171,7 @@ class Ukf : public GaussianFilter<N> {
       if (i > 0 && states.col(i) == states.col(0)) {
         z_sigma.col(i) = z_sigma.col(0);
       } else {
-        z_sigma.col(i) = model.predict(State(states.col(i)));
+        predict_into(model, State(states.col(i)), z_sigma.col(i));
       }
     }
     if (!z_sigma.allFinite()) {

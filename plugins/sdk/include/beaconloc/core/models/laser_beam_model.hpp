@@ -44,8 +44,12 @@ class LaserBeamModel {
   template <int N>
   Vector predict(const Vec<N>& x) const {
     Vector out(size());
-    if (size() > 0) expected_laser_ranges(*grid_, pose_.pose_of(x), beams_, out.data());
+    predict_into(x, out);
     return out;
+  }
+  template <int N>
+  void predict_into(const Vec<N>& x, Eigen::Ref<Eigen::VectorXd> out) const {
+    if (size() > 0) expected_laser_ranges(*grid_, pose_.pose_of(x), beams_, out.data());
   }
   Eigen::MatrixXd noise() const { return variance_m2_ * Eigen::MatrixXd::Identity(size(), size()); }
   Vector residual(const Vector& z, const Vector& h) const { return z - h; }

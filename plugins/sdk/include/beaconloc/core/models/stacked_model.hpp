@@ -35,12 +35,16 @@ class ModelList {
   template <int N>
   Vector predict(const Vec<N>& x) const {
     Vector out(size_);
+    predict_into(x, out);
+    return out;
+  }
+  template <int N>
+  void predict_into(const Vec<N>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     Eigen::Index at = 0;
     for (const Part& p : parts_) {
-      out.segment(at, p.size()) = p.predict(x);
+      beaconloc::predict_into(p, x, out.segment(at, p.size()));
       at += p.size();
     }
-    return out;
   }
   template <int N>
   MeasurementLinearization<Eigen::Dynamic, N> linearize(const Vec<N>& x) const {
@@ -100,9 +104,13 @@ class StackedModel {
   template <int N>
   Vector predict(const Vec<N>& x) const {
     Vector out(size());
-    out.head(first_.size()) = first_.predict(x);
-    out.tail(second_.size()) = second_.predict(x);
+    predict_into(x, out);
     return out;
+  }
+  template <int N>
+  void predict_into(const Vec<N>& x, Eigen::Ref<Eigen::VectorXd> out) const {
+    beaconloc::predict_into(first_, x, out.head(first_.size()));
+    beaconloc::predict_into(second_, x, out.tail(second_.size()));
   }
   template <int N>
   MeasurementLinearization<Eigen::Dynamic, N> linearize(const Vec<N>& x) const {
