@@ -47,9 +47,11 @@ class SigmaPoints {
   explicit SigmaPoints(UnscentedWeights weights) : weights_(std::move(weights)) {}
   UnscentedWeights weights_;
   Eigen::MatrixXd states_;
-  // Each point's measurement noise (m x (2L + 1)), the augmented part of seed 001 eq. 8 (chi_n);
-  // no rows when R is added to S instead.
-  Eigen::MatrixXd measurement_noise_;
+  // The augmented points as drawn ([x; w_u; v] x (2L + 1)): their last measurement_rows_ rows are
+  // each point's measurement noise, the augmented part of seed 001 eq. 8 (chi_n); none when R
+  // is added to S instead. Kept whole, not copied out.
+  Eigen::MatrixXd augmented_;
+  Eigen::Index measurement_rows_ = 0;
   Eigen::MatrixXd r_;  // the R they spread (augmented) or are to add
   Vec<N> mean_;        // the belief they spread: the filter's when they were drawn
   Mat<N, N> covariance_;
@@ -89,7 +91,7 @@ class Ukf : public GaussianFilter<N> {
     }
     std::optional<SigmaPoints<N>> points = draw(input_noise, measurement_noise);
     if (!points) return {{FilterOutcome::kNotPositiveDefinite}, std::nullopt};
-    const Eigen::MatrixXd& chi = points->states_;  // the augmented points until moved
+    const Eigen::MatrixXd& chi = points->augmented_;
     Eigen::MatrixXd moved(n, chi.cols());
     for (Eigen::Index i = 0; i < chi.cols(); ++i) {
       // A point that spreads only measurement noise moves as the first: no second motion step.
@@ -162,7 +164,7 @@ class Ukf : public GaussianFilter<N> {
     const Eigen::Index n = this->x_.size(), m = model.size();
     const Eigen::MatrixXd& states = points.states_;
     const UnscentedWeights& w = points.weights_;
-    const bool augmented = points.measurement_noise_.rows() > 0;
+    const bool augmented = points.measurement_rows_ > 0;
     const Eigen::Index count = states.cols();
     Eigen::MatrixXd z_sigma(m, count);
     for (Eigen::Index i = 0; i < count; ++i) {
@@ -178,7 +180,7 @@ class Ukf : public GaussianFilter<N> {
       result.outcome = FilterOutcome::kNonFinite;
       return result;
     }
-    if (augmented) z_sigma += points.measurement_noise_;  // seed 001 eq. 16: + chi_n
+    if (augmented) z_sigma += points.augmented_.bottomRows(points.measurement_rows_);  // eq. 16: + chi_n
     typename Model::Vector z_mean;
     Eigen::MatrixXd z_centred(m, count);
     if constexpr (plain_residual_v<Model>) {
@@ -236,8 +238,8 @@ class Ukf : public GaussianFilter<N> {
     return l >= 1 && p.alpha * p.alpha * (static_cast<double>(l) + p.kappa) > 0.0;
   }
   // Sigma points (eq. 2) of the belief augmented with zero-mean noises (eq. 4-5, 7): the input's
-  // and the measurement's, block-diagonal; the augmented points left in states_ for predict to
-  // move, the measurement's rows split off. nullopt when not positive definite.
+  // and the measurement's, block-diagonal; the augmented points kept whole, for predict to
+  // move (the measurement's rows last). nullopt when not positive definite.
   std::optional<SigmaPoints<N>> draw(const Eigen::MatrixXd& input_noise, const Eigen::MatrixXd& measurement_noise) const {
     const Eigen::Index n = this->x_.size(), n_u = input_noise.rows(), m = measurement_noise.rows();
     const Eigen::Index l = n + n_u + m;
@@ -251,8 +253,9 @@ class Ukf : public GaussianFilter<N> {
     SigmaPoints<N> points{UnscentedWeights(l, options_.unscented)};
     std::optional<Eigen::MatrixXd> chi = beaconloc::sigma_points(mean_a, cov_a, points.weights_);
     if (!chi) return std::nullopt;
-    points.measurement_noise_ = chi->bottomRows(m);
-    points.states_ = n_u > 0 ? std::move(*chi) : Eigen::MatrixXd(chi->topRows(n));
+    points.augmented_ = std::move(*chi);
+    points.measurement_rows_ = m;
+    if (n_u == 0) points.states_ = points.augmented_.topRows(n);  // no motion to move them
     points.r_ = measurement_noise;
     points.mean_ = this->x_;
     points.covariance_ = this->p_;
