@@ -70,28 +70,28 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
       {ranges_topic_.c_str(), "ros2.beacon_ranges.writer", ""});
   if (options_.odometry_in) {
     odometry_in_writer_ = participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic);
-    participant_.subscribe<nav_msgs::msg::OdometryPubSubType>(
+    readers_.push_back(participant_.subscribe<nav_msgs::msg::OdometryPubSubType>(
         {odom_in_topic_.c_str(), "", "ros2.odom.reader"},
-        [this](const nav_msgs::msg::Odometry& m) { on_ros_odometry(m); });
+        [this](const nav_msgs::msg::Odometry& m) { on_ros_odometry(m); }));
   }
   if (options_.scan_in) {
     scan_in_writer_ = participant_.writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic);
-    participant_.subscribe<sensor_msgs::msg::LaserScanPubSubType>(
+    readers_.push_back(participant_.subscribe<sensor_msgs::msg::LaserScanPubSubType>(
         {scan_in_topic_.c_str(), "", "ros2.scan.reader"},
-        [this](const sensor_msgs::msg::LaserScan& m) { on_ros_scan(m); });
+        [this](const sensor_msgs::msg::LaserScan& m) { on_ros_scan(m); }));
   }
   initial_pose_writer_ = participant_.writer<msg::InitialPosePubSubType>(dds::kInitialPoseTopic);
-  participant_.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+  readers_.push_back(participant_.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
       {initial_pose_topic_.c_str(), "", "ros2.initialpose.reader"},
-      [this](const geometry_msgs::msg::PoseWithCovarianceStamped& m) { on_ros_initial_pose(m); });
-  participant_.subscribe<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic,
-                                                      [this](const msg::PoseEstimate& m) { on_pose(m); });
-  participant_.subscribe<msg::OdometryPubSubType>(dds::kOdometryTopic,
-                                                  [this](const msg::Odometry& m) { on_odometry(m); });
-  participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic,
-                                                   [this](const msg::BeaconMap& m) { on_beacon_map(m); });
-  participant_.subscribe<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic,
-                                                     [this](const msg::BeaconRange& m) { on_range(m); });
+      [this](const geometry_msgs::msg::PoseWithCovarianceStamped& m) { on_ros_initial_pose(m); }));
+  readers_.push_back(participant_.subscribe<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic,
+                                                      [this](const msg::PoseEstimate& m) { on_pose(m); }));
+  readers_.push_back(participant_.subscribe<msg::OdometryPubSubType>(dds::kOdometryTopic,
+                                                  [this](const msg::Odometry& m) { on_odometry(m); }));
+  readers_.push_back(participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic,
+                                                   [this](const msg::BeaconMap& m) { on_beacon_map(m); }));
+  readers_.push_back(participant_.subscribe<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic,
+                                                     [this](const msg::BeaconRange& m) { on_range(m); }));
   publish_static_frames();
   if (options_.beacons) {
     auto markers = beacon_markers(*options_.beacons, options_.map_frame, dds::wall_clock_ns());
@@ -99,11 +99,6 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
   }
   diagnostics_ =
       std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] { return diagnostics_snapshot(); });
-}
-
-BridgeParticipant::~BridgeParticipant() {
-  diagnostics_->stop();
-  participant_.close();
 }
 
 void BridgeParticipant::publish_static_frames() {

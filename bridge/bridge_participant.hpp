@@ -15,6 +15,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "beaconloc/core/beacon_map.hpp"
 #include "beaconloc/core/estimator.hpp"
@@ -53,7 +54,6 @@ std::string ros_topic(const std::string& ros_namespace, const std::string& name)
 class BridgeParticipant {
  public:
   BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions options);
-  ~BridgeParticipant();
   const RejectionCounter& counts() const { return counts_; }
 
  private:
@@ -90,16 +90,17 @@ class BridgeParticipant {
   std::string beacon_pose_topic_, odometry_out_topic_, beacons_topic_, ranges_topic_, odom_in_topic_,
       scan_in_topic_, initial_pose_topic_;
   dds::Participant participant_;
-  eprosima::fastdds::dds::DataWriter* beacon_pose_writer_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* odometry_out_writer_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* tf_writer_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* tf_static_writer_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* beacons_writer_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* ranges_writer_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* odometry_in_writer_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* scan_in_writer_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* initial_pose_writer_ = nullptr;
+  dds::Writer beacon_pose_writer_;
+  dds::Writer odometry_out_writer_;
+  dds::Writer tf_writer_;
+  dds::Writer tf_static_writer_;
+  dds::Writer beacons_writer_;
+  dds::Writer ranges_writer_;
+  dds::Writer odometry_in_writer_;
+  dds::Writer scan_in_writer_;
+  dds::Writer initial_pose_writer_;
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
+  std::vector<dds::Reader> readers_;  // last: they stop before what their callbacks use goes
 };
 
 }  // namespace beaconloc::bridge

@@ -34,12 +34,12 @@ int run_feeder(const dds::DdsOptions& dds, int robots, double seconds) {
     runs.push_back(simulate(scenario, static_cast<std::uint64_t>(s + 1), seconds + 1.0));
 
   dds::Participant participant(dds, "beaconloc.bench.fleet_feeder");
-  auto* map_writer = participant.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
+  auto map_writer = participant.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
   // The gateways' writer QoS with a history sized for a writer of many robots
   // (fleet_feeder_qos.xml says why).
-  auto* tof_writer = participant.writer<msg::RawTofPubSubType>(
+  auto tof_writer = participant.writer<msg::RawTofPubSubType>(
       {dds::kRawTofTopic.name, "fleet_feeder.raw_tof.writer", dds::kRawTofTopic.reader_profile});
-  auto* odometry_writer = participant.writer<msg::OdometryPubSubType>(
+  auto odometry_writer = participant.writer<msg::OdometryPubSubType>(
       {dds::kOdometryTopic.name, "fleet_feeder.odometry.writer", dds::kOdometryTopic.reader_profile});
   auto map = dds::to_msg(BeaconMap(scenario.beacons), "map");
   map_writer->write(&map);

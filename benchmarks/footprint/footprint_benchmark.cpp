@@ -39,7 +39,7 @@ struct Run {
 Run run_once(const dds::DdsOptions& dds, double settle_s, const std::string& dir) {
   std::atomic<std::int64_t> first_pose_ns{0};
   dds::Participant participant(dds, "beaconloc.bench.footprint");
-  participant.subscribe<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic, [&](const msg::PoseEstimate&) {
+  dds::Reader reader = participant.subscribe<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic, [&](const msg::PoseEstimate&) {
     std::int64_t expected = 0;
     first_pose_ns.compare_exchange_strong(expected, Clock::now().time_since_epoch().count());
   });
@@ -80,7 +80,6 @@ Run run_once(const dds::DdsOptions& dds, double settle_s, const std::string& dir
       std::fprintf(stderr, "footprint: %s exited %d (log %s)\n", name.c_str(), code.value_or(-1),
                    dir.c_str());
   }
-  participant.close();
   return run;
 }
 

@@ -144,10 +144,10 @@ PipelineResult run_pipeline(const Settings& st, const Transport& t) {
     o.domain_id = st.pipeline_domain;
     o.participant_profile = t.profile;
     dds::Participant participant(o, "beaconloc.latency.gateway");
-    DataWriter* map_writer = participant.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
-    DataWriter* tof_writer = participant.writer<msg::RawTofPubSubType>(dds::kRawTofTopic);
-    DataWriter* odometry_writer = participant.writer<msg::OdometryPubSubType>(dds::kOdometryTopic);
-    DataReader* pose_reader = participant.subscribe<msg::PoseEstimatePubSubType>(
+    dds::Writer map_writer = participant.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
+    dds::Writer tof_writer = participant.writer<msg::RawTofPubSubType>(dds::kRawTofTopic);
+    dds::Writer odometry_writer = participant.writer<msg::OdometryPubSubType>(dds::kOdometryTopic);
+    dds::Reader pose_reader = participant.subscribe<msg::PoseEstimatePubSubType>(
         dds::kPoseEstimateTopic, [&](const msg::PoseEstimate& m) {
           const std::int64_t arrival = now_ns();
           std::lock_guard<std::mutex> lock(poses_mutex);
@@ -158,8 +158,8 @@ PipelineResult run_pipeline(const Settings& st, const Transport& t) {
     wait_until(
         "the decoder and localizer to match",
         [&] {
-          return matched_readers(map_writer) >= 2 && matched_readers(tof_writer) >= 1 &&
-                 matched_readers(odometry_writer) >= 1 && matched_writers(pose_reader) >= 1;
+          return matched_readers(map_writer.get()) >= 2 && matched_readers(tof_writer.get()) >= 1 &&
+                 matched_readers(odometry_writer.get()) >= 1 && matched_writers(pose_reader.get()) >= 1;
         },
         30s, children);
     // The same liveliness assertion as the gateway (manual by topic, lease 1 s).
@@ -210,7 +210,6 @@ PipelineResult run_pipeline(const Settings& st, const Transport& t) {
       }
     }
     liveliness.reset();
-    participant.close();
   }
   // Stop the children now (they leave cleanly on SIGTERM) and say if one failed.
   for (auto* c : children) {

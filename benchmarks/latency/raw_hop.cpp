@@ -51,14 +51,13 @@ int run_echo(int domain, const std::string& profile) {
   o.domain_id = domain;
   o.participant_profile = profile;
   dds::Participant participant(o, "beaconloc.latency.echo");
-  DataWriter* pong = participant.writer<msg::RawTofPubSubType>(kPongTopic);
-  participant.subscribe<msg::RawTofPubSubType>(kPingTopic, [pong](const msg::RawTof& m) {
+  dds::Writer pong = participant.writer<msg::RawTofPubSubType>(kPongTopic);
+  dds::Reader reader = participant.subscribe<msg::RawTofPubSubType>(kPingTopic, [&pong](const msg::RawTof& m) {
     msg::RawTof copy = m;
     pong->write(&copy);
   });
   while (!dds::wait_for_stop(1s)) {
   }
-  participant.close();
   return 0;
 }
 
@@ -78,8 +77,8 @@ HopResult run_hop(const Settings& st, const Transport& t) {
     std::uint64_t awaited = 0;
     std::int64_t sent_ns = 0;
     std::optional<std::int64_t> rtt_ns;
-    DataWriter* ping = participant.writer<msg::RawTofPubSubType>(kPingTopic);
-    DataReader* pong_reader =
+    dds::Writer ping = participant.writer<msg::RawTofPubSubType>(kPingTopic);
+    dds::Reader pong_reader =
         participant.subscribe<msg::RawTofPubSubType>(kPongTopic, [&](const msg::RawTof& m) {
           const std::int64_t arrival = now_ns();
           std::lock_guard<std::mutex> lock(mutex);
@@ -89,7 +88,7 @@ HopResult run_hop(const Settings& st, const Transport& t) {
         });
     wait_until(
         "the echo peer to match",
-        [&] { return matched_readers(ping) >= 1 && matched_writers(pong_reader) >= 1; }, 30s, children);
+        [&] { return matched_readers(ping.get()) >= 1 && matched_writers(pong_reader.get()) >= 1; }, 30s, children);
     auto liveliness = std::make_unique<dds::PeriodicTask>(250ms, [&] { ping->assert_liveliness(); });
     std::uint64_t sequence = 0;
     // One round trip: the time from just before write() to the pong's arrival in the listener
@@ -148,7 +147,6 @@ HopResult run_hop(const Settings& st, const Transport& t) {
       }
     }
     liveliness.reset();
-    participant.close();
   }
   const auto s = echo.stop();
   if (s && *s != 0) std::fprintf(stderr, "latency: the echo peer exited with status %d\n", *s);

@@ -11,7 +11,7 @@ DecoderParticipant::DecoderParticipant(const dds::DdsOptions& dds, TofDecoderCon
     : decoder_(config),
       participant_(dds, "beaconloc.decoder"),
       range_writer_(participant_.writer<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic)) {
-  participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [this](const msg::BeaconMap& m) {
+  map_reader_ = participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [this](const msg::BeaconMap& m) {
     std::vector<DecodedRange> held;
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -23,15 +23,10 @@ DecoderParticipant::DecoderParticipant(const dds::DdsOptions& dds, TofDecoderCon
   tof_events.deadline_misses = &deadline_misses_;
   tof_events.writers_lost = &tof_writers_lost_;
   tof_events.lost_and_none_alive = &tof_writer_lost_;
-  participant_.subscribe<msg::RawTofPubSubType>(
+  tof_reader_ = participant_.subscribe<msg::RawTofPubSubType>(
       dds::kRawTofTopic, [this](const msg::RawTof& m) { on_raw_tof(m); }, tof_events);
   diagnostics_ =
       std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] { return diagnostics_snapshot(); });
-}
-
-DecoderParticipant::~DecoderParticipant() {
-  diagnostics_->stop();
-  participant_.close();  // stop the callbacks before the members they use are destroyed
 }
 
 void DecoderParticipant::on_raw_tof(const msg::RawTof& m) {

@@ -15,7 +15,6 @@ namespace beaconloc {
 class DecoderParticipant {
  public:
   DecoderParticipant(const dds::DdsOptions& dds, TofDecoderConfig config);
-  ~DecoderParticipant();
   void publish_diagnostics() { diagnostics_->publish_now(); }
   // Waits until the range writer has a matched reader (false on timeout).
   bool wait_for_readers(std::chrono::milliseconds timeout) const {
@@ -37,9 +36,12 @@ class DecoderParticipant {
   std::atomic<bool> tof_writer_lost_{false};  // lost, none alive since
   std::atomic<std::uint64_t> tofs_processed_{0};
   std::atomic<std::uint64_t> ranges_written_{0};
+  // The entities, owned: the readers, declared last, stop first, before what they use goes.
   dds::Participant participant_;
-  eprosima::fastdds::dds::DataWriter* range_writer_;
+  dds::Writer range_writer_;
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
+  dds::Reader map_reader_;
+  dds::Reader tof_reader_;
 };
 
 }  // namespace beaconloc

@@ -72,10 +72,7 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
 }
 
 GatewayParticipant::~GatewayParticipant() {
-  liveliness_.reset();
-  stop();
-  diagnostics_->stop();
-  participant_.close();
+  stop();  // joins the run thread: a std::thread must not be destroyed running
 }
 
 bool GatewayParticipant::wait_for_readers(std::chrono::milliseconds timeout) const {

@@ -82,10 +82,12 @@ class GatewayParticipant {
   TruthCallback on_truth_;
   Throttle throttle_;
   dds::Participant participant_;
-  eprosima::fastdds::dds::DataWriter* map_writer_;
-  eprosima::fastdds::dds::DataWriter* tof_writer_;
-  eprosima::fastdds::dds::DataWriter* odometry_writer_;
-  eprosima::fastdds::dds::DataWriter* scan_writer_;
+  // Owned; what writes through them (the run thread, the liveliness and Diagnostics tasks) is
+  // declared after them, so stops before they go.
+  dds::Writer map_writer_;
+  dds::Writer tof_writer_;
+  dds::Writer odometry_writer_;
+  dds::Writer scan_writer_;
   std::ofstream truth_;
   std::ofstream record_tof_;
   std::ofstream record_odometry_;

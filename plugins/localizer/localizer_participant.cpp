@@ -29,7 +29,7 @@ void LocalizerParticipant::subscribe_beacon_measurements(const dds::TopicSpec& t
     std::lock_guard<std::mutex> lock(mutex_);
     core_.on_ranges_silent(key.robot_id());
   };
-  participant_.subscribe<PubSubType>(
+  readers_.push_back(participant_.subscribe<PubSubType>(
       topic,
       [this, fuse](const Msg& m) {
         {
@@ -40,7 +40,7 @@ void LocalizerParticipant::subscribe_beacon_measurements(const dds::TopicSpec& t
         }
         ++ranges_processed_;
       },
-      events);
+      events));
 }
 
 LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core)
@@ -58,7 +58,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       core_.set_beacon_map(*agreed);
     }
   };
-  participant_.subscribe_with_info<msg::BeaconMapPubSubType>(
+  readers_.push_back(participant_.subscribe_with_info<msg::BeaconMapPubSubType>(
       dds::kBeaconMapTopic,
       [this](const msg::BeaconMap& m, const eprosima::fastdds::dds::SampleInfo& info) {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -66,7 +66,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
           map_sources_.on_map(dds::writer_id(info.publication_handle), core_.beacon_map());
         }
       },
-      map_events);
+      map_events));
   // The beacon measurements: the decoder's ranges, or for an estimator that turns times of flight
   // into ranges itself (it estimates the speed of sound, seed 002) the gateway's raw TOFs; never
   // both. A robot whose measurements miss their deadline (two beacon slots) coasts on odometry,
@@ -93,21 +93,21 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
     std::lock_guard<std::mutex> lock(mutex_);
     core_.on_odometry_deadline_missed(key.robot_id());
   };
-  participant_.subscribe<msg::OdometryPubSubType>(
-      dds::kOdometryTopic, [this](const msg::Odometry& m) { on_odometry(m); }, odometry_events);
+  readers_.push_back(participant_.subscribe<msg::OdometryPubSubType>(
+      dds::kOdometryTopic, [this](const msg::Odometry& m) { on_odometry(m); }, odometry_events));
   if (core_.uses_laser()) {
-    participant_.subscribe<msg::LaserScanPubSubType>(dds::kLaserScanTopic, [this](const msg::LaserScan& m) {
+    readers_.push_back(participant_.subscribe<msg::LaserScanPubSubType>(dds::kLaserScanTopic, [this](const msg::LaserScan& m) {
       std::lock_guard<std::mutex> lock(mutex_);
       if (auto corrected = core_.on_laser(m.robot_id(), dds::from_msg(m))) publish(*corrected);
-    });
+    }));
   }
-  participant_.subscribe<msg::InitialPosePubSubType>(
+  readers_.push_back(participant_.subscribe<msg::InitialPosePubSubType>(
       dds::kInitialPoseTopic, [this](const msg::InitialPose& m) {
         Cov3 c;
         for (int i = 0; i < 9; ++i) c(i / 3, i % 3) = m.covariance()[static_cast<std::size_t>(i)];
         std::lock_guard<std::mutex> lock(mutex_);
         core_.on_initial_pose(m.robot_id(), m.stamp_ns(), Pose2(m.x_m(), m.y_m(), m.yaw_rad()), c);
-      });
+      }));
   diagnostics_ =
       std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] { return diagnostics_snapshot(); });
   own_diagnostics_writer_ = diagnostics_->writer();
@@ -121,12 +121,12 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
     std::lock_guard<std::mutex> lock(mutex_);
     conflicts_.on_peer_gone(dds::writer_id(info.publication_handle), steady_ns());
   };
-  participant_.subscribe_with_info<msg::DiagnosticsPubSubType>(
+  readers_.push_back(participant_.subscribe_with_info<msg::DiagnosticsPubSubType>(
       dds::kDiagnosticsTopic,
       [this](const msg::Diagnostics& d, const eprosima::fastdds::dds::SampleInfo& info) {
         on_peer_diagnostics(d, dds::writer_id(info.publication_handle));
       },
-      peer_events);
+      peer_events));
 }
 
 void LocalizerParticipant::on_peer_diagnostics(const msg::Diagnostics& d, const std::string& writer) {
@@ -138,11 +138,6 @@ void LocalizerParticipant::on_peer_diagnostics(const msg::Diagnostics& d, const 
   }
   conflicts_.on_peer_report(writer, d.participant(),
                             {d.robots_localized().begin(), d.robots_localized().end()}, steady_ns());
-}
-
-LocalizerParticipant::~LocalizerParticipant() {
-  diagnostics_->stop();
-  participant_.close();
 }
 
 void LocalizerParticipant::on_odometry(const msg::Odometry& m) {

@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "beaconloc/core/beacon_map_sources.hpp"
 #include "beaconloc/dds/diagnostics_publisher.hpp"
@@ -22,7 +23,6 @@ namespace beaconloc {
 class LocalizerParticipant {
  public:
   LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core);
-  ~LocalizerParticipant();
   void publish_diagnostics() { diagnostics_->publish_now(); }
   // Samples taken from the bus, for a throttle in the same process.
   std::uint64_t odometry_processed() const { return odometry_processed_.load(); }
@@ -67,9 +67,11 @@ class LocalizerParticipant {
   std::atomic<std::uint64_t> ranges_processed_{0};
   std::atomic<std::uint64_t> poses_written_{0};
   std::atomic<StampNs> newest_odometry_stamp_ns_{0};
+  // The entities, owned: the readers, declared last, stop first, before what they use goes.
   dds::Participant participant_;
-  eprosima::fastdds::dds::DataWriter* pose_writer_;
+  dds::Writer pose_writer_;
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
+  std::vector<dds::Reader> readers_;
 };
 
 }  // namespace beaconloc

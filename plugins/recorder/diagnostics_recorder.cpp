@@ -46,8 +46,6 @@ DiagnosticsRecorder::DiagnosticsRecorder(const dds::DdsOptions& dds)
     : participant_(dds, "beaconloc.diagnostics_recorder"),
       reader_(participant_.reader<msg::DiagnosticsPubSubType>(dds::kDiagnosticsTopic, &listener_)) {}
 
-DiagnosticsRecorder::~DiagnosticsRecorder() { participant_.close(); }
-
 void DiagnosticsRecorder::read(bool fresh) const {
   LoanableSequence<msg::Diagnostics> data;
   SampleInfoSeq infos;

@@ -41,7 +41,6 @@ Liveness liveness_of(eprosima::fastdds::dds::InstanceStateKind state, std::chron
 class DiagnosticsRecorder {
  public:
   explicit DiagnosticsRecorder(const dds::DdsOptions& dds);
-  ~DiagnosticsRecorder();
   // By participant name, with each one's liveness now.
   std::map<std::string, ParticipantReport> reports() const;
   // The newest report of each participant that ever reported, gone or not (its counts).
@@ -71,7 +70,7 @@ class DiagnosticsRecorder {
   mutable std::map<eprosima::fastdds::dds::InstanceHandle_t, Entry> entries_;  // by instance
   Listener listener_{*this};
   dds::Participant participant_;
-  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+  dds::Reader reader_;  // last: stops before the listener and the entries go
 };
 
 // One line per participant: its liveness and status, accepted, rejected by reason, deadline

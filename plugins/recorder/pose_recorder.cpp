@@ -8,7 +8,7 @@ namespace beaconloc {
 
 PoseRecorder::PoseRecorder(const dds::DdsOptions& dds, Keep keep)
     : keep_(keep), participant_(dds, "beaconloc.pose_recorder") {
-  participant_.subscribe_with_info<msg::PoseEstimatePubSubType>(
+  reader_ = participant_.subscribe_with_info<msg::PoseEstimatePubSubType>(
       dds::kPoseEstimateTopic,
       [this](const msg::PoseEstimate& m, const eprosima::fastdds::dds::SampleInfo& info) {
         RecordedPose p{{m.robot_id(), dds::from_msg(m), m.estimator()}, std::chrono::steady_clock::now()};
@@ -25,8 +25,6 @@ PoseRecorder::PoseRecorder(const dds::DdsOptions& dds, Keep keep)
         poses_.push_back(std::move(p));
       });
 }
-
-PoseRecorder::~PoseRecorder() { participant_.close(); }
 
 std::vector<RecordedPose> PoseRecorder::poses() const {
   std::lock_guard<std::mutex> lock(mutex_);

@@ -25,7 +25,6 @@ class PoseRecorder {
  public:
   enum class Keep { kEveryPose, kNewestPerRobot };
   explicit PoseRecorder(const dds::DdsOptions& dds, Keep keep = Keep::kEveryPose);
-  ~PoseRecorder();
   // Every pose received (kEveryPose), or the newest of each robot (kNewestPerRobot).
   std::vector<RecordedPose> poses() const;
   std::size_t count() const;        // finite poses received, corrections not counted again
@@ -41,6 +40,7 @@ class PoseRecorder {
   std::vector<RecordedPose> poses_;                                              // kEveryPose
   std::map<std::pair<std::string, std::string>, std::size_t> newest_of_writer_;  // (robot, writer) -> poses_
   dds::Participant participant_;
+  dds::Reader reader_;  // last: stops before what its callback uses goes
 };
 
 std::vector<EstimateRow> rows_of(const std::vector<RecordedPose>& poses);

@@ -29,7 +29,7 @@ class BadInput : public ParticipantsTest {
   // comes next on the other topics is then judged against the map, whatever order the topics
   // would have delivered them in.
   static void send_map(const DiagnosticsRecorder& recorder, const std::string& name,
-                       eprosima::fastdds::dds::DataWriter* map_writer) {
+                       const dds::Writer& map_writer) {
     auto map = dds::to_msg(BeaconMap(sim::default_scenario().beacons), "map");
     ASSERT_TRUE(map_writer->write(&map));
     auto has_map = [](const msg::Diagnostics& r) {
@@ -44,8 +44,8 @@ TEST_F(BadInput, DecoderRefusesEveryBadTofByReason) {
   DiagnosticsRecorder diagnostics(dds_);
   ChildProcess decoder(command("decoder"), dir_ + "/decoder.log");
   dds::Participant bus(dds_, "test.faulty_gateway");
-  auto* map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
-  auto* tof_writer = bus.writer<msg::RawTofPubSubType>(dds::kRawTofTopic);
+  auto map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
+  auto tof_writer = bus.writer<msg::RawTofPubSubType>(dds::kRawTofTopic);
   ASSERT_TRUE(dds::wait_for_matched_readers({map_writer, tof_writer}, scaled(10s))) << decoder.log();
   ASSERT_NO_FATAL_FAILURE(send_map(diagnostics, kDecoder, map_writer));
 
@@ -104,9 +104,9 @@ TEST_F(BadInput, LocalizerRefusesEveryBadSampleByReason) {
   DiagnosticsRecorder diagnostics(dds_);
   ChildProcess localizer(command("localizer", {"--robot", "robot1"}), dir_ + "/localizer.log");
   dds::Participant bus(dds_, "test.faulty_robot");
-  auto* map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
-  auto* odometry_writer = bus.writer<msg::OdometryPubSubType>(dds::kOdometryTopic);
-  auto* range_writer = bus.writer<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic);
+  auto map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
+  auto odometry_writer = bus.writer<msg::OdometryPubSubType>(dds::kOdometryTopic);
+  auto range_writer = bus.writer<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic);
   ASSERT_TRUE(dds::wait_for_matched_readers({map_writer, odometry_writer, range_writer}, scaled(10s)))
       << localizer.log();
   ASSERT_NO_FATAL_FAILURE(send_map(diagnostics, kRangeEkfLocalizer, map_writer));

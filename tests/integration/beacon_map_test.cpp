@@ -170,7 +170,7 @@ TEST_F(BeaconMapOnTheBus, MalformedMapsAreRefusedByReasonAndTheGoodOneKept) {
   ChildProcess localizer(command("localizer"), path("localizer.log"));
   ChildProcess decoder(command("decoder"), path("decoder.log"));
   dds::Participant bus(dds_, "test.faulty_gateway");
-  auto* map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
+  auto map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
   ASSERT_TRUE(eventually(
       [&] {
         eprosima::fastdds::dds::PublicationMatchedStatus status;

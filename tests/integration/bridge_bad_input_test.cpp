@@ -30,24 +30,24 @@ TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
   dds::DdsOptions options = dds_;
   options.extra_qos_files = {std::string(BEACONLOC_SOURCE_DIR) + "/tests/integration/rviz2_readers.xml"};
   dds::Participant bus(options, "test.faulty_localizer");
-  auto* pose_writer = bus.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic);
-  auto* range_writer = bus.writer<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic);
-  auto* map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
+  auto pose_writer = bus.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic);
+  auto range_writer = bus.writer<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic);
+  auto map_writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
   std::mutex mutex;
   std::vector<geometry_msgs::msg::PoseWithCovarianceStamped> poses;
   std::vector<sensor_msgs::msg::Range> ranges;
   std::size_t marker_arrays = 0;
-  auto* pose_reader = bus.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+  auto pose_reader = bus.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
       {"rt/beacon_pose", "", "rviz2.reader"}, [&](const auto& m) {
         std::lock_guard<std::mutex> lock(mutex);
         poses.push_back(m);
       });
-  auto* range_reader = bus.subscribe<sensor_msgs::msg::RangePubSubType>(
+  auto range_reader = bus.subscribe<sensor_msgs::msg::RangePubSubType>(
       {"rt/beacon_ranges", "", "rviz2.reader"}, [&](const auto& m) {
         std::lock_guard<std::mutex> lock(mutex);
         ranges.push_back(m);
       });
-  auto* markers_reader = bus.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>(
+  auto markers_reader = bus.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>(
       {"rt/beacons", "", "rviz2.reader"}, [&](const auto&) {
         std::lock_guard<std::mutex> lock(mutex);
         ++marker_arrays;
@@ -58,9 +58,9 @@ TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
   // that (the ranges are volatile) would never reach them.
   ASSERT_TRUE(eventually(
       [&] {
-        for (auto* reader : {pose_reader, range_reader, markers_reader}) {
+        for (const dds::Reader* reader : {&pose_reader, &range_reader, &markers_reader}) {
           eprosima::fastdds::dds::SubscriptionMatchedStatus status;
-          reader->get_subscription_matched_status(status);
+          reader->get()->get_subscription_matched_status(status);
           if (status.current_count == 0) return false;
         }
         return true;

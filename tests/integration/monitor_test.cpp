@@ -85,7 +85,7 @@ class Monitor : public ParticipantsTest {
   }
   // Writes every pose and waits for each batch to be acknowledged: the writer keeps 10 per
   // robot, and a reliable keep-last writer overwrites what no reader has acknowledged yet.
-  static void write_acknowledged(eprosima::fastdds::dds::DataWriter* writer,
+  static void write_acknowledged(const dds::Writer& writer,
                                  std::vector<msg::PoseEstimate> poses) {
     for (std::size_t i = 0; i < poses.size(); ++i) {
       ASSERT_TRUE(writer->write(&poses[i]));
@@ -235,7 +235,7 @@ TEST_F(Monitor, ALocalizerRefusesAPeerReportListingMoreRobotsThanTheBound) {
   DiagnosticsRecorder diagnostics(dds_);
   ChildProcess localizer(command("localizer"), path("localizer.log"));
   dds::Participant bus(dds_, "test.fake_localizer");
-  auto* writer = bus.writer<msg::DiagnosticsPubSubType>(dds::kDiagnosticsTopic);
+  auto writer = bus.writer<msg::DiagnosticsPubSubType>(dds::kDiagnosticsTopic);
   ASSERT_TRUE(wait_until([&] { return diagnostics.latest().count(name) == 1; }, 15s)) << localizer.log();
   msg::Diagnostics d;
   d.participant("test.fake_localizer");
@@ -246,7 +246,6 @@ TEST_F(Monitor, ALocalizerRefusesAPeerReportListingMoreRobotsThanTheBound) {
       [&] { return rejected_count(diagnostics.latest().at(name), "diagnostics.too_many_robots") == 1; }, 15s))
       << localizer.log();
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer, "localizer"));
-  bus.close();
 }
 
 // Item 12 of issue 23: the monitor kept (and copied each second) every pose. Without --truth or
@@ -257,7 +256,7 @@ TEST_F(Monitor, TheRecorderKeepsOnePosePerRobotUnlessItRecordsEveryPose) {
   PoseRecorder newest(dds_, PoseRecorder::Keep::kNewestPerRobot);
   PoseRecorder every(dds_, PoseRecorder::Keep::kEveryPose);
   dds::Participant bus(dds_, "test.localizer");
-  auto* writer = bus.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic);
+  auto writer = bus.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic);
   ASSERT_TRUE(wait_until(
       [&] {
         eprosima::fastdds::dds::PublicationMatchedStatus s;
@@ -301,7 +300,6 @@ TEST_F(Monitor, TheRecorderKeepsOnePosePerRobotUnlessItRecordsEveryPose) {
     corrected += p.row.estimate.pose_map_base.x() == 42.0;
   }
   EXPECT_EQ(corrected, 1u);
-  bus.close();
 }
 
 // The monitor with --out writes every pose it got, and neither its lines nor the file carry a
@@ -309,7 +307,7 @@ TEST_F(Monitor, TheRecorderKeepsOnePosePerRobotUnlessItRecordsEveryPose) {
 TEST_F(Monitor, WithOutTheMonitorWritesEveryPoseAndNoNonFiniteNumber) {
   ChildProcess monitor(command("monitor", {"--out", path("poses.csv")}), path("monitor.log"));
   dds::Participant bus(dds_, "test.localizer");
-  auto* writer = bus.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic);
+  auto writer = bus.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic);
   ASSERT_TRUE(dds::wait_for_matched_readers({writer}, scaled(15s))) << monitor.log();
   std::vector<msg::PoseEstimate> sent;
   for (int i = 1; i <= 250; ++i) {
@@ -349,7 +347,7 @@ TEST_F(Monitor, WithTruthThatCoversNoPoseItScoresNothingAndFails) {
   }
   ChildProcess monitor(command("monitor", {"--truth", path("truth.csv")}), path("monitor.log"));
   dds::Participant bus(dds_, "test.localizer");
-  auto* writer = bus.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic);
+  auto writer = bus.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic);
   ASSERT_TRUE(dds::wait_for_matched_readers({writer}, scaled(15s))) << monitor.log();
   std::vector<msg::PoseEstimate> sent;
   for (int i = 1; i <= 50; ++i) sent.push_back(pose("ra", i * 10 * kNsPerMillisecond, 0.01 * i));

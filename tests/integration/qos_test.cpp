@@ -37,13 +37,12 @@ class RangeRecorder {
     StampNs received_wall_ns;
   };
   explicit RangeRecorder(const dds::DdsOptions& dds) : participant_(dds, "test.range_recorder") {
-    participant_.subscribe<msg::BeaconRangePubSubType>(
+    reader_ = participant_.subscribe<msg::BeaconRangePubSubType>(
         dds::kBeaconRangeTopic, [this](const msg::BeaconRange& m) {
           std::lock_guard<std::mutex> lock(mutex_);
           ranges_.push_back({m.stamp_ns(), dds::wall_clock_ns()});
         });
   }
-  ~RangeRecorder() { participant_.close(); }
   std::vector<Received> ranges() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return ranges_;
@@ -53,6 +52,7 @@ class RangeRecorder {
   mutable std::mutex mutex_;
   std::vector<Received> ranges_;
   dds::Participant participant_;
+  dds::Reader reader_;  // last: stops before the ranges it fills go
 };
 
 class Qos : public ParticipantsTest {

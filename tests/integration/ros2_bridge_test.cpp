@@ -89,20 +89,20 @@ TEST_F(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics
   Inbox<sensor_msgs::msg::Range> ranges;
   {
     dds::Participant rviz(options, "test.rviz2");
-    rviz.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+    const dds::Reader reader_1 = rviz.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
         {"rt/beacon_pose", "", "rviz2.reader"}, [&](const auto& m) { poses.add(m); });
-    rviz.subscribe<nav_msgs::msg::OdometryPubSubType>({"rt/odometry/beacons", "", "rviz2.reader"},
+    const dds::Reader reader_2 = rviz.subscribe<nav_msgs::msg::OdometryPubSubType>({"rt/odometry/beacons", "", "rviz2.reader"},
                                                       [&](const auto& m) { odometry.add(m); });
-    rviz.subscribe<tf2_msgs::msg::TFMessagePubSubType>({"rt/tf", "", "rviz2.reader"},
+    const dds::Reader reader_3 = rviz.subscribe<tf2_msgs::msg::TFMessagePubSubType>({"rt/tf", "", "rviz2.reader"},
                                                        [&](const auto& m) { tf.add(m); });
-    auto* beacons_reader = rviz.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>(
+    auto beacons_reader = rviz.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>(
         {"rt/beacons", "", "rviz2.reader"}, [&](const auto& m) { beacons.add(m); });
-    rviz.subscribe<sensor_msgs::msg::RangePubSubType>({"rt/beacon_ranges", "", "rviz2.reader"},
+    const dds::Reader reader_4 = rviz.subscribe<sensor_msgs::msg::RangePubSubType>({"rt/beacon_ranges", "", "rviz2.reader"},
                                                       [&](const auto& m) { ranges.add(m); });
     // tf_static with rviz2's QoS too: it matches (the one message went out before we joined).
-    auto* tf_static_reader = rviz.subscribe<tf2_msgs::msg::TFMessagePubSubType>(
+    auto tf_static_reader = rviz.subscribe<tf2_msgs::msg::TFMessagePubSubType>(
         {"rt/tf_static", "", "rviz2.reader"}, [](const tf2_msgs::msg::TFMessage&) {});
-    auto matched = [&](eprosima::fastdds::dds::DataReader* reader) {
+    auto matched = [&](const dds::Reader& reader) {
       return eventually(
           [&] {
             eprosima::fastdds::dds::SubscriptionMatchedStatus status;
@@ -172,7 +172,7 @@ TEST_F(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics
     // reset is looked at, not the newest one now and then: one of them jumps more than 0.6 m ahead
     // of the pose before it (10 ms earlier: driving at 0.34 m/s the robot moves 3.4 mm), to about
     // where the reset put it. However late the reset arrives, that jump is its mark.
-    auto* writer = rviz.writer<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+    auto writer = rviz.writer<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
         {"rt/initialpose", "test.initialpose.writer", ""});
     ASSERT_TRUE(dds::wait_for_matched_readers({writer}, scaled(5s)));
     const std::size_t poses_before = poses.size();
@@ -193,7 +193,6 @@ TEST_F(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics
         },
         10s))
         << "last x " << poses.last().pose().pose().position().x() << ", wanted about " << wanted_x;
-    rviz.close();
   }
 
   // A late listener of the latched topics: the newest pose, the receiver frames, the beacons.
@@ -201,11 +200,11 @@ TEST_F(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics
   Inbox<tf2_msgs::msg::TFMessage> late_static;
   Inbox<visualization_msgs::msg::MarkerArray> late_beacons;
   dds::Participant late(options, "test.late");
-  late.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+  const dds::Reader reader_1 = late.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
       {"rt/beacon_pose", "", "late.reader"}, [&](const auto& m) { late_poses.add(m); });
-  late.subscribe<tf2_msgs::msg::TFMessagePubSubType>({"rt/tf_static", "", "late.reader"},
+  const dds::Reader reader_2 = late.subscribe<tf2_msgs::msg::TFMessagePubSubType>({"rt/tf_static", "", "late.reader"},
                                                      [&](const auto& m) { late_static.add(m); });
-  late.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>({"rt/beacons", "", "late.reader"},
+  const dds::Reader reader_3 = late.subscribe<visualization_msgs::msg::MarkerArrayPubSubType>({"rt/beacons", "", "late.reader"},
                                                                  [&](const auto& m) { late_beacons.add(m); });
   ASSERT_TRUE(eventually([&] { return late_poses.size() && late_static.size() && late_beacons.size(); }, 10s))
       << late_poses.size() << " " << late_static.size() << " " << late_beacons.size();
@@ -217,7 +216,6 @@ TEST_F(Ros2Bridge, Rviz2ReadersMatchEveryOutputAndLateReadersGetTheLatchedTopics
                          frames.transforms()[1].transform().translation().y()),
               0.19, 1e-9);
   EXPECT_EQ(late_beacons.last().markers().size(), 13u);  // clear all, then six beacons' sphere and label
-  late.close();
 
   run.signal(SIGTERM);
   EXPECT_TRUE(run.wait(20s));
@@ -233,9 +231,9 @@ TEST_F(Ros2Bridge, InitialPosesWhileTrackingNeverStallARunInOneProcess) {
   Inbox<geometry_msgs::msg::PoseWithCovarianceStamped> poses;
   {
     dds::Participant rviz(options, "test.rviz2");
-    rviz.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+    const dds::Reader reader_5 = rviz.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
         {"rt/beacon_pose", "", "rviz2.reader"}, [&](const auto& m) { poses.add(m); });
-    auto* writer = rviz.writer<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
+    auto writer = rviz.writer<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
         {"rt/initialpose", "test.initialpose.writer", ""});
     ASSERT_TRUE(eventually([&] { return poses.size() > 50; }, 30s)) << run.log();
     ASSERT_TRUE(dds::wait_for_matched_readers({writer}, scaled(5s)));
@@ -249,7 +247,6 @@ TEST_F(Ros2Bridge, InitialPosesWhileTrackingNeverStallARunInOneProcess) {
     EXPECT_TRUE(eventually([&] { return poses.size() > after_clicks + 100; }, 20s))
         << "the poses stopped at " << poses.size() << "\n"
         << run.log();
-    rviz.close();
   }
   run.signal(SIGTERM);
   const auto code = run.wait(30s);

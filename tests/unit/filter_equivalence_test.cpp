@@ -1,7 +1,8 @@
 // The filters of core/filters pinned to each other and to the textbook (issue 14):
 //  - the iterated EKF with one iteration is the EKF, bit for bit;
 //  - the UKF, the EKF, the IEKF and the H-infinity filter at theta = 0 are the textbook Kalman
-//    filter on a linear model;
+//    filter on a linear model, and so is the UKF that corrects with the sigma points its
+//    prediction drew (seed 001 Table 1), which refuses points drawn for another belief;
 //  - the H-infinity filter tends to the EKF as its bound is relaxed (theta -> 0);
 //  - the IEKF on a static range-only problem converges to the Gauss-Newton solution
 //    (core/solvers/range_pose_solver);
@@ -12,6 +13,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -23,45 +25,11 @@
 #include "beaconloc/core/models/linear_model.hpp"
 #include "beaconloc/core/models/linear_motion.hpp"
 #include "beaconloc/core/models/range_model.hpp"
+#include "beaconloc/core/models/stacked_model.hpp"
 #include "beaconloc/core/solvers/range_pose_solver.hpp"
 
 namespace beaconloc {
 namespace {
-
-// Several ranges at once, stacked: the batch problem a Gauss-Newton solver solves.
-class StackedRanges {
- public:
-  static constexpr int kSize = Eigen::Dynamic;
-  static constexpr bool kHasJacobian = true;
-  using Vector = Eigen::VectorXd;
-  explicit StackedRanges(std::vector<RangeModel> ranges) : ranges_(std::move(ranges)) {}
-  Eigen::Index size() const { return static_cast<Eigen::Index>(ranges_.size()); }
-  template <int N>
-  Vector predict(const Vec<N>& x) const {
-    return linearize(x).predicted;
-  }
-  template <int N>
-  MeasurementLinearization<Eigen::Dynamic, N> linearize(const Vec<N>& x) const {
-    MeasurementLinearization<Eigen::Dynamic, N> out;
-    out.predicted.resize(size());
-    out.jacobian.resize(size(), x.size());
-    for (Eigen::Index i = 0; i < size(); ++i) {
-      const auto one = ranges_[static_cast<std::size_t>(i)].linearize(x);
-      out.predicted(i) = one.predicted(0);
-      out.jacobian.row(i) = one.jacobian;
-    }
-    return out;
-  }
-  Eigen::MatrixXd noise() const {
-    Eigen::MatrixXd r = Eigen::MatrixXd::Zero(size(), size());
-    for (Eigen::Index i = 0; i < size(); ++i) r(i, i) = ranges_[static_cast<std::size_t>(i)].noise()(0, 0);
-    return r;
-  }
-  Vector residual(const Vector& z, const Vector& h) const { return z - h; }
-
- private:
-  std::vector<RangeModel> ranges_;
-};
 
 Mat<3, 3> prior_covariance() {
   Mat<3, 3> p;
@@ -106,7 +74,46 @@ struct Textbook {
   }
 };
 
-template <class Filter>
+// The UKF as seed 001 Table 1 runs it: one draw per iteration, the update correcting with the
+// sigma points its prediction drew (R = r drawn in).
+class OneDrawUkf {
+ public:
+  explicit OneDrawUkf(Eigen::MatrixXd r) : r_(std::move(r)) {}
+  FilterOutcome reset(const Vec<4>& x, const Mat<4, 4>& p) { return ukf_.reset(x, p); }
+  template <class Motion>
+  PredictResult predict(const Motion& motion, const typename Motion::Input& u, double dt_s) {
+    Ukf<4>::Predicted predicted = ukf_.predict(motion, u, dt_s, r_);
+    points_ = std::move(predicted.points);
+    return predicted.result;
+  }
+  template <class Model>
+  UpdateResult update(const Model& model, const typename Model::Vector& z) {
+    if (!points_) return {FilterOutcome::kStaleSigmaPoints};
+    return ukf_.update(*points_, model, z);
+  }
+  const Vec<4>& state() const { return ukf_.state(); }
+  const Mat<4, 4>& covariance() const { return ukf_.covariance(); }
+
+ private:
+  Ukf<4> ukf_;
+  Eigen::MatrixXd r_;
+  std::optional<SigmaPoints<4>> points_;
+};
+
+// A linear motion whose noise is all on its input (Q = 0), as seed 001's: the UKF's prediction
+// then keeps the points it moved for the update instead of drawing again.
+struct InputNoiseOnly : LinearMotion<4, 2> {
+  static constexpr bool kHasStateNoise = false;
+  using LinearMotion<4, 2>::LinearMotion;
+};
+
+Mat<2, 2> linear_model_noise() {
+  Mat<2, 2> r;
+  r << 0.01, 0.002, 0.002, 0.02;
+  return r;
+}
+
+template <class Filter, class Motion = LinearMotion<4, 2>>
 void expect_textbook_on_linear_model(Filter filter, double tol) {
   // A constant-velocity model on [x, y, vx, vy] with an acceleration input, observed in position.
   const double dt = 0.1;
@@ -117,13 +124,12 @@ void expect_textbook_on_linear_model(Filter filter, double tol) {
   b(0, 0) = b(1, 1) = 0.5 * dt * dt;
   b(2, 0) = b(3, 1) = dt;
   const Mat<2, 2> uc = 0.04 * Mat<2, 2>::Identity();
-  const Mat<4, 4> q = 1e-4 * Mat<4, 4>::Identity();
+  const Mat<4, 4> q = (Motion::kHasStateNoise ? 1e-4 : 0.0) * Mat<4, 4>::Identity();
   Mat<2, 4> h = Mat<2, 4>::Zero();
   h(0, 0) = h(1, 1) = 1.0;
   h(0, 2) = 0.1;  // a little of the velocity in the first reading
-  Mat<2, 2> r;
-  r << 0.01, 0.002, 0.002, 0.02;
-  const LinearMotion<4, 2> motion(f, b, uc, q);
+  const Mat<2, 2> r = linear_model_noise();
+  const Motion motion(f, b, uc, q);
   const LinearModel<2, 4> model(h, r);
   Textbook kf{Vec<4>(0.0, 1.0, 0.5, -0.2), Mat<4, 4>::Identity()};
   filter.reset(kf.x, kf.p);
@@ -151,6 +157,36 @@ TEST(FilterEquivalence, EveryFilterIsTheTextbookKalmanFilterOnALinearModel) {
   UkfOptions augmented;
   augmented.augment_measurement_noise = true;
   expect_textbook_on_linear_model(Ukf<4>(StateSpace<4>(), augmented), 1e-9);
+}
+
+TEST(FilterEquivalence, TheUkfCorrectingWithThePointsItsPredictionDrewIsTheTextbookKalmanFilter) {
+  // One draw over [x; w_u; v] per iteration (seed 001 Table 1) ...
+  expect_textbook_on_linear_model<OneDrawUkf, InputNoiseOnly>(OneDrawUkf(linear_model_noise()), 1e-9);
+  // ... and, with noise on the state (Q), the points drawn again from the prior.
+  expect_textbook_on_linear_model(OneDrawUkf(linear_model_noise()), 1e-9);
+}
+
+TEST(FilterEquivalence, TheUkfRefusesSigmaPointsDrawnForAnotherBeliefOrAnotherNoise) {
+  Ukf<3> ukf(pose_space());
+  ukf.reset(Vec<3>(1.0, 2.0, 0.3), prior_covariance());
+  const RangeModel model({0.19, 0.0}, 0.0, {3.0, 4.0, 2.5}, 1e-2);
+  const std::optional<SigmaPoints<3>> points = ukf.sigma_points(model.noise());
+  ASSERT_TRUE(points);
+  const std::optional<SigmaPoints<3>> other_noise = ukf.sigma_points(Mat<1, 1>(2e-2));
+  ASSERT_TRUE(other_noise);
+  EXPECT_EQ(ukf.update(*other_noise, model, Vec<1>(3.4)).outcome, FilterOutcome::kStaleSigmaPoints);
+  EXPECT_EQ(ukf.state(), Vec<3>(1.0, 2.0, 0.3));
+  ASSERT_TRUE(ukf.update(*points, model, Vec<1>(3.4)).applied());
+  const Vec<3> corrected = ukf.state();
+  const Mat<3, 3> corrected_cov = ukf.covariance();
+  // Used again after the belief moved: refused, nothing changed.
+  EXPECT_EQ(ukf.update(*points, model, Vec<1>(3.4)).outcome, FilterOutcome::kStaleSigmaPoints);
+  EXPECT_EQ(ukf.state(), corrected);
+  EXPECT_EQ(ukf.covariance(), corrected_cov);
+  // Points of another size (a 2-range R) against a 1-range model: refused, not an assertion.
+  const std::optional<SigmaPoints<3>> two = ukf.sigma_points(Eigen::Matrix2d::Identity() * 1e-2);
+  ASSERT_TRUE(two);
+  EXPECT_EQ(ukf.update(*two, model, Vec<1>(3.4)).outcome, FilterOutcome::kStaleSigmaPoints);
 }
 
 TEST(FilterEquivalence, HInfinityTendsToTheEkfAsItsBoundIsRelaxed) {
@@ -215,7 +251,7 @@ TEST(FilterEquivalence, TheIteratedEkfOnAStaticRangeProblemConvergesToGaussNewto
   // pulls it by ~1e-9 m; a far larger P only loses digits in the gain).
   IteratedEkf<3> iekf(pose_space(), {50, 1e-10});
   iekf.reset(Vec<3>(truth + Pose2(0.5, -0.4, 0.3)), 1e4 * Mat<3, 3>::Identity());
-  const auto result = iekf.update(StackedRanges(models), z);
+  const auto result = iekf.update(ModelList<RangeModel>(models), z);
   ASSERT_TRUE(result.applied()) << to_string(result.outcome);
   EXPECT_GT(result.iterations, 2);
   EXPECT_LT(result.iterations, 50);
@@ -226,7 +262,7 @@ TEST(FilterEquivalence, TheIteratedEkfOnAStaticRangeProblemConvergesToGaussNewto
   // The EKF, one linearization from the same prior, stops short of it.
   Ekf<3> ekf(pose_space());
   ekf.reset(Vec<3>(truth + Pose2(0.5, -0.4, 0.3)), 1e4 * Mat<3, 3>::Identity());
-  ASSERT_TRUE(ekf.update(StackedRanges(models), z).applied());
+  ASSERT_TRUE(ekf.update(ModelList<RangeModel>(models), z).applied());
   EXPECT_GT(pose_difference(ekf.state(), gauss_newton.pose).norm(), 1e-3);
 }
 
@@ -255,7 +291,7 @@ void expect_failures_change_nothing(Filter filter) {
   EXPECT_TRUE(unchanged());
   EXPECT_EQ(filter.update(good, Vec<1>(1e3), 10.0).outcome, FilterOutcome::kGated);
   EXPECT_TRUE(unchanged());
-  EXPECT_EQ(filter.update(StackedRanges({good, good}), Eigen::VectorXd::Zero(3)).outcome,
+  EXPECT_EQ(filter.update(ModelList<RangeModel>({good, good}), Eigen::VectorXd::Zero(3)).outcome,
             FilterOutcome::kSizeMismatch);
   EXPECT_TRUE(unchanged());
   EXPECT_EQ(filter.predict(DiffDriveMotion(0.4, Eigen::Matrix2d::Identity()), Eigen::Vector2d(std::nan(""), 0.0), 0.1)

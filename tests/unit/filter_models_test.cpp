@@ -11,6 +11,7 @@
 #include "beaconloc/core/models/pose_observation_model.hpp"
 #include "beaconloc/core/models/range_difference_model.hpp"
 #include "beaconloc/core/models/range_model.hpp"
+#include "beaconloc/core/models/stacked_model.hpp"
 #include "beaconloc/core/models/velocity_motion.hpp"
 
 namespace beaconloc {
@@ -143,6 +144,63 @@ TEST(LaserBeamModel, HasNoJacobianAndPredictsRayCasts) {
   EXPECT_NEAR(h(0), 3.9 - 1.05, 1e-9);
   EXPECT_NEAR(h(1), 2.9 - 1.25, 1e-9);
   EXPECT_EQ(model.noise(), 0.01 * Eigen::MatrixXd::Identity(2, 2));
+}
+
+TEST(StackedModel, RangesAndAPoseObservationStackTheirHJacobianNoiseAndResiduals) {
+  const PoseIndex pose{1, 2, 0};
+  const StateSpace<4> space = StateSpace<4>::with_pose(pose);
+  ModelList<RangeModel> ranges;
+  ranges.add(RangeModel({0.19, 0.0}, 0.1, {2.0, 3.0, 2.5}, 1e-4, pose));
+  ranges.add(RangeModel({-0.1, 0.2}, 0.1, {-1.0, 0.5, 2.7}, 4e-4, pose));
+  Cov3 pose_cov;
+  pose_cov << 0.01, 0.002, 0.0, 0.002, 0.02, 0.001, 0.0, 0.001, 0.03;
+  const PoseObservationModel fix(pose_cov, pose);
+  const StackedModel<ModelList<RangeModel>, PoseObservationModel> model(ranges, fix);
+  ASSERT_EQ(model.size(), 5);
+  const Vec<4> x(3.1, 1.0, 2.0, 7.0);  // [yaw, x, y, other]
+  expect_jacobian_matches(model, space, x, 1e-8);
+  const Eigen::VectorXd h = model.predict(x);
+  EXPECT_EQ(h(0), ranges.parts()[0].predict(x)(0));
+  EXPECT_EQ(h(1), ranges.parts()[1].predict(x)(0));
+  EXPECT_EQ(Vec<3>(h.tail(3)), fix.predict(x));
+  // R block-diagonal: the parts' own noises, nothing across them.
+  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(5, 5);
+  r(0, 0) = 1e-4;
+  r(1, 1) = 4e-4;
+  r.bottomRightCorner(3, 3) = pose_cov;
+  EXPECT_EQ(model.noise(), r);
+  // Each part's residual: the heading's wraps, the ranges' do not.
+  Eigen::VectorXd z = h;
+  z(0) += 0.5;
+  z(4) = -3.1;
+  const Eigen::VectorXd res = model.residual(z, h);
+  EXPECT_NEAR(res(0), 0.5, 1e-12);
+  EXPECT_EQ(res(1), 0.0);
+  EXPECT_NEAR(res(4), 2.0 * M_PI - 6.2, 1e-12);
+}
+
+TEST(MeasurementModels, OnlyModelsWithoutAnAngleSayTheirResidualIsThePlainDifference) {
+  static_assert(plain_residual_v<RangeModel> && plain_residual_v<RangeDifferenceModel> &&
+                    plain_residual_v<ArrivalTimeModel> && plain_residual_v<LaserBeamModel>,
+                "");
+  static_assert(!plain_residual_v<PoseObservationModel>, "its residual wraps the heading");
+  static_assert(plain_residual_v<StackedModel<ModelList<RangeModel>, LaserBeamModel>>, "");
+  static_assert(!plain_residual_v<StackedModel<ModelList<RangeModel>, PoseObservationModel>>, "");
+  static_assert(!plain_residual_v<ModelList<PoseObservationModel>>, "");
+  // And the one that says so computes it: z - h, whatever the numbers.
+  const RangeModel range({0.0, 0.0}, 0.0, {1.0, 1.0, 2.5}, 0.16);
+  EXPECT_EQ(range.residual(Vec<1>(-3.5), Vec<1>(3.5))(0), -7.0);
+}
+
+TEST(StackedModel, WithoutAJacobianInAPartTheStackHasNone) {
+  static_assert(!StackedModel<ModelList<RangeModel>, LaserBeamModel>::kHasJacobian, "");
+  static_assert(ModelList<RangeModel>::kHasJacobian, "");
+  // An empty part (no beams: no grid needed, no ray cast) leaves the other as it is.
+  ModelList<RangeModel> ranges({RangeModel({0.0, 0.0}, 0.0, {1.0, 1.0, 2.5}, 0.16)});
+  const StackedModel<ModelList<RangeModel>, LaserBeamModel> model(ranges, LaserBeamModel(nullptr, LaserBeams{}, 0.01));
+  EXPECT_EQ(model.size(), 1);
+  EXPECT_EQ(model.predict(Vec<3>(0.0, 0.0, 0.0)), ranges.predict(Vec<3>(0.0, 0.0, 0.0)));
+  EXPECT_EQ(model.noise(), Eigen::MatrixXd::Constant(1, 1, 0.16));
 }
 
 // A motion model's F and G against central differences of x (+) dx(x, u).

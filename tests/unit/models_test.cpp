@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "beaconloc/core/models/range_model.hpp"
@@ -98,6 +99,30 @@ TEST(RangeModel, JacobianMatchesNumeric) {
       }
     }
   }
+}
+
+}  // namespace
+}  // namespace beaconloc
+
+namespace beaconloc {
+namespace {
+
+TEST(WrapAngle, KeepsAnAngleInsideBitForBitAndWrapsOthersIntoMinusPiExcludedToPi) {
+  for (const double a : {0.0, -0.0, 1e-300, 3.0, -3.0, M_PI, std::nextafter(-M_PI, 0.0), 2.5}) {
+    EXPECT_EQ(wrap_angle_rad(a), a) << a;
+  }
+  EXPECT_EQ(wrap_angle_rad(-M_PI), M_PI);  // the interval's one end
+  EXPECT_EQ(wrap_angle_rad(3.0 * M_PI), M_PI);
+  // Against the trigonometric definition, on a sweep far outside and across the ends.
+  for (double a = -1000.0; a < 1000.0; a += 0.377) {
+    const double w = wrap_angle_rad(a);
+    EXPECT_GT(w, -M_PI) << a;
+    EXPECT_LE(w, M_PI) << a;
+    EXPECT_NEAR(std::remainder(w - std::atan2(std::sin(a), std::cos(a)), 2.0 * M_PI), 0.0, 1e-12) << a;
+  }
+  EXPECT_TRUE(std::isnan(wrap_angle_rad(std::numeric_limits<double>::quiet_NaN())));
+  EXPECT_TRUE(std::isnan(wrap_angle_rad(std::numeric_limits<double>::infinity())));
+  EXPECT_TRUE(std::isnan(wrap_angle_rad(-std::numeric_limits<double>::infinity())));
 }
 
 }  // namespace

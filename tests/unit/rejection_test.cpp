@@ -29,7 +29,8 @@ TEST(Rejection, EveryReasonHasItsOwnSnakeCaseName) {
 
 TEST(Rejection, EveryFilterOutcomeHasItsReason) {
   for (FilterOutcome o : {FilterOutcome::kGated, FilterOutcome::kSingularInnovation, FilterOutcome::kNotPositiveDefinite,
-                          FilterOutcome::kBoundNotMet, FilterOutcome::kNonFinite, FilterOutcome::kSizeMismatch}) {
+                          FilterOutcome::kBoundNotMet, FilterOutcome::kNonFinite, FilterOutcome::kSizeMismatch,
+                          FilterOutcome::kStaleSigmaPoints}) {
     EXPECT_STREQ(to_string(o), to_string(*rejection_for(o)));
   }
   EXPECT_EQ(rejection_for(FilterOutcome::kGated), Rejection::kGatedNis);

@@ -136,7 +136,7 @@ InputResult Duhl::update(const RangeMeasurement& r) {
   if (it == available_.end()) it = available_.emplace(r.beacon_id, new_tx_estimate(r)).first;
   // Eq. 25-27 for the one receiver this range is from (R diagonal: one scalar update per
   // receiver is the same as the three at once), Joseph form.
-  Ekf<3> q_filter;
+  Ekf<3>& q_filter = distance_filter_;
   q_filter.reset(it->second.q, it->second.covariance);
   Eigen::Matrix<double, 1, 3> h = Eigen::Matrix<double, 1, 3>::Zero();
   h(r.receiver_id) = 1.0;

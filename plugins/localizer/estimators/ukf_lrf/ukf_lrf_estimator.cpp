@@ -1,20 +1,17 @@
 #include "ukf_lrf_estimator.hpp"
 
-#include <Eigen/Cholesky>
 #include <cmath>
 #include <stdexcept>
 
 #include "beaconloc/core/estimator_parameters.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
-#include "beaconloc/core/filters/symmetric.hpp"
 #include "beaconloc/core/models/range_model.hpp"
-#include "beaconloc/core/models/velocity_motion.hpp"
+#include "beaconloc/core/models/stacked_model.hpp"
 
 namespace beaconloc::ukf_lrf {
 namespace {
 
 constexpr int kPose = 3;
-constexpr int kMotionNoise = 2;  // eq. 8: n_u on (v, omega)
 
 std::string mode_name(Mode mode) {
   switch (mode) {
@@ -74,7 +71,13 @@ UkfLrf::UkfLrf(const EstimatorConfig& config, Mode mode)
     : UkfLrf(config, mode, UkfLrfParameters::from(config, mode_name(mode))) {}
 
 UkfLrf::UkfLrf(const EstimatorConfig& config, Mode mode, const UkfLrfParameters& params)
-    : EstimatorBase(params.max_odometry_gap_s), mode_(mode), params_(params), grid_(config.occupancy_grid) {
+    : EstimatorBase(params.max_odometry_gap_s),
+      mode_(mode),
+      params_(params),
+      grid_(config.occupancy_grid),
+      motion_model_(params.alpha),
+      // Eq. 16: the measurement noise augmented, as the paper's sigma points spread it.
+      filter_(pose_space(), UkfOptions{params.unscented, true}) {
   if (mode_ != Mode::kBeaconsOnly && !grid_) {
     throw std::invalid_argument(name() + " needs the occupancy grid of the map (localizer --map FILE)");
   }
@@ -86,11 +89,10 @@ UkfLrf::UkfLrf(const EstimatorConfig& config, Mode mode, const UkfLrfParameters&
     receiver_height_m_ = config.receivers.receiver_height_m;
   }
   if (params_.initial_pose) {
-    mean_ = *params_.initial_pose;
-    covariance_ = Cov3(Eigen::Vector3d(params_.initial_sigma_xy_m * params_.initial_sigma_xy_m,
+    filter_.reset(*params_.initial_pose, Cov3(Eigen::Vector3d(params_.initial_sigma_xy_m * params_.initial_sigma_xy_m,
                                        params_.initial_sigma_xy_m * params_.initial_sigma_xy_m,
                                        params_.initial_sigma_yaw_rad * params_.initial_sigma_yaw_rad)
-                           .asDiagonal());
+                           .asDiagonal()));
     start(0);
   }
 }
@@ -205,134 +207,85 @@ std::vector<Rejection> UkfLrf::take_deferred_rejections() {
 InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurement> ranges,
                          const ScanBeams* scan) {
   last_step_predicted_ = false;
-  const int n_u = motion ? kMotionNoise : 0;
   const int n_b = static_cast<int>(ranges.size()), n_w = scan ? static_cast<int>(scan->ranges_m.size()) : 0;
   if (!motion && n_b + n_w == 0) return InputResult::ok();
 
-  // Eq. 1-5, 7: augmented mean (noises zero-mean, eq. 4) and block-diagonal covariance.
-  const Eigen::Index l = kPose + n_u + n_b + n_w;
-  Eigen::VectorXd mean_a = Eigen::VectorXd::Zero(l);
-  mean_a.head<3>() = mean_;
-  Eigen::MatrixXd cov_a = Eigen::MatrixXd::Zero(l, l);
-  cov_a.topLeftCorner<3, 3>() = covariance_;
-  if (motion) {
-    // Eq. 6, floored so that a robot at rest keeps a positive-definite augmented covariance.
-    const Eigen::Vector2d m =
-        velocity_noise_variance(motion->v_mps, motion->omega_radps, params_.alpha).cwiseMax(1e-12);
-    cov_a.block<2, 2>(kPose, kPose) = m.asDiagonal();
-  }
-  // Eq. 7: variances (ERRATA: the paper's diagonal writes sigma where sigma^2 is meant).
-  for (int k = 0; k < n_b; ++k) cov_a(kPose + n_u + k, kPose + n_u + k) = std::pow(params_.beacon_sigma_m, 2);
-  for (int k = 0; k < n_w; ++k) {
-    const Eigen::Index i = kPose + n_u + n_b + k;
-    cov_a(i, i) = std::pow(params_.laser_sigma_m, 2);
-  }
-  const UnscentedWeights w(l, params_.unscented);
-  const auto chi_a = sigma_points(mean_a, cov_a, w);  // eq. 2
-  if (!chi_a) return InputResult::rejected(Rejection::kCovarianceNotPositiveDefinite);
-  const Eigen::Index n_sigma = chi_a->cols();
+  // Eq. 16: h is the beacon ranges (each to the beacon Table 2 associates it with), then the
+  // beams; eq. 7 their noise, augmented (variances: ERRATA, the paper's diagonal writes sigma
+  // where sigma^2 is meant). The association needs the sigma points, which need R first.
+  const double beacon_variance_m2 = params_.beacon_sigma_m * params_.beacon_sigma_m;
+  const double laser_variance_m2 = params_.laser_sigma_m * params_.laser_sigma_m;
+  Eigen::VectorXd r_diagonal(n_b + n_w);
+  r_diagonal.head(n_b).setConstant(beacon_variance_m2);
+  r_diagonal.tail(n_w).setConstant(laser_variance_m2);
+  const Eigen::MatrixXd r = r_diagonal.asDiagonal();
 
-  // Eq. 9-11: every sigma point moved with its own velocity noise (without motion: as it is).
-  Eigen::MatrixXd chi_x = chi_a->topRows(3);
-  for (Eigen::Index i = 0; motion && i < n_sigma; ++i) {
-    if (i > 0 && chi_a->col(i).head(kPose + n_u) == chi_a->col(0).head(kPose + n_u)) {
-      chi_x.col(i) = chi_x.col(0);  // a point that spreads only measurement noise moves as the mean
-      continue;
-    }
-    chi_x.col(i) = predict_velocity_motion(Pose2(chi_a->col(i).head<3>()), motion->v_mps + (*chi_a)(kPose, i),
-                                           motion->omega_radps + (*chi_a)(kPose + 1, i), motion->dt_s);
-  }
-  // Eq. 12-13, the heading averaged as offsets from the first sigma point (wrapped).
-  const double heading_ref = chi_x(2, 0);
-  Eigen::MatrixXd offsets = chi_x;
-  for (Eigen::Index i = 0; i < n_sigma; ++i) offsets(2, i) = wrap_angle_rad(chi_x(2, i) - heading_ref);
-  Pose2 prior = weighted_mean(offsets, w);
-  prior.z() = wrap_angle_rad(prior.z() + heading_ref);
-  Eigen::MatrixXd x_centred = chi_x.colwise() - Eigen::Vector3d(prior);
-  for (Eigen::Index i = 0; i < n_sigma; ++i) x_centred(2, i) = wrap_angle_rad(x_centred(2, i));
-  Cov3 prior_cov = weighted_cross_covariance(x_centred, x_centred, w);
-  prior_cov = symmetrized(prior_cov);
+  // Eq. 1-14: one set of sigma points over [x; n_u; n_B; n_W], moved by the motion (eq. 9-11),
+  // the prior kept whatever the correction does.
+  std::optional<SigmaPoints<3>> points;
   if (motion) {
-    mean_ = prior;
-    covariance_ = prior_cov;
+    Ukf<3>::Predicted predicted =
+        filter_.predict(motion_model_, Eigen::Vector2d(motion->v_mps, motion->omega_radps), motion->dt_s, r);
+    if (!predicted.result.applied()) return InputResult::of(predicted.result.outcome);
     last_step_predicted_ = true;
+    points = std::move(predicted.points);
+  } else {
+    points = filter_.sigma_points(r);
   }
   if (n_b + n_w == 0) return InputResult::ok();
+  if (!points) return InputResult::rejected(Rejection::kCovarianceNotPositiveDefinite);
 
-  // Table 2: the predicted range to every beacon over the sigma points, then each measured
-  // range's most likely beacon.
-  const std::vector<Beacon> beacons = map().beacons();
-  std::vector<std::uint32_t> associated(n_b);
-  if (n_b > 0) {
-    std::vector<PredictedBeaconRange> predicted;
-    for (const Beacon& b : beacons) {
-      Eigen::VectorXd z(n_sigma);
-      for (Eigen::Index i = 0; i < n_sigma; ++i) {
-        z(i) = i > 0 && chi_x.col(i) == chi_x.col(0) ? z(0)
-                                                     : predict_range(Pose2(chi_x.col(i)), receiver_base_m_,
-                                                                     receiver_height_m_, b.position_map_m)
-                                                           .range_m;
-      }
-      const double mean_z = z.dot(w.mean);  // line 3
-      const Eigen::RowVectorXd centred = (z.array() - mean_z).matrix().transpose();
-      const double var_z = (centred * w.covariance.asDiagonal() * centred.transpose())(0, 0) +
-                           std::pow(params_.beacon_sigma_m, 2);  // line 4, with its noise (line 2)
-      predicted.push_back({b.id, mean_z, var_z});
-    }
-    for (int k = 0; k < n_b; ++k) {
-      const auto j = most_likely_beacon(ranges[k].range_m, predicted);  // lines 6-11
-      if (!j) return InputResult::rejected(Rejection::kNoBeaconToAssociate);
-      associated[k] = *j;
-    }
+  const std::optional<std::vector<std::uint32_t>> associated = associate(ranges, *points);
+  if (!associated) return InputResult::rejected(Rejection::kNoBeaconToAssociate);
+  ModelList<RangeModel> beacon_ranges;
+  for (const std::uint32_t id : *associated) {
+    beacon_ranges.add(
+        RangeModel(receiver_base_m_, receiver_height_m_, map().find(id)->position_map_m, beacon_variance_m2));
   }
-
-  // Eq. 16-20: predicted measurements (beacon ranges, then beams) plus their noise sigma points.
-  const Eigen::Index n_z = n_b + n_w;
-  Eigen::MatrixXd z_sigma(n_z, n_sigma);
-  for (Eigen::Index i = 0; i < n_sigma; ++i) {
-    // The sigma points that spread only measurement noise (eq. 8's chi_n^B, chi_n^W) keep the
-    // mean's pose: their h is the first point's, computed once (exact, and 5x fewer rays).
-    if (i > 0 && chi_x.col(i) == chi_x.col(0)) {
-      z_sigma.col(i) = z_sigma.col(0);
-      continue;
-    }
-    const Pose2 pose(chi_x.col(i));
-    for (int k = 0; k < n_b; ++k) {
-      z_sigma(k, i) =
-          predict_range(pose, receiver_base_m_, receiver_height_m_, map().find(associated[k])->position_map_m)
-              .range_m;
-    }
-    if (n_w > 0) expected_laser_ranges(*grid_, pose, scan->beams, z_sigma.col(i).data() + n_b);
-  }
-  z_sigma += chi_a->bottomRows(n_z);  // eq. 16: + chi_n
-  Eigen::VectorXd z_measured(n_z);
-  for (int k = 0; k < n_b; ++k) z_measured(k) = ranges[k].range_m;
-  for (int k = 0; k < n_w; ++k) z_measured(n_b + k) = scan->ranges_m[k];
-  const Eigen::VectorXd z_mean = weighted_mean(z_sigma, w);  // eq. 18
-  const Eigen::MatrixXd z_centred = z_sigma.colwise() - z_mean;
-  const Eigen::MatrixXd s = weighted_cross_covariance(z_centred, z_centred, w);   // eq. 19
-  const Eigen::MatrixXd xz = weighted_cross_covariance(x_centred, z_centred, w);  // eq. 20
-  // Eq. 15 prints K = Sigma_xz S; the gain is Sigma_xz S^-1, from a checked LDLT of S.
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(s);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().array() > 0.0).all()) {
-    return InputResult::rejected(Rejection::kSingularInnovation);
-  }
-  const Eigen::MatrixXd k_gain = ldlt.solve(xz.transpose()).transpose();
-  Pose2 posterior = prior + k_gain * (z_measured - z_mean);  // eq. 21
-  posterior.z() = wrap_angle_rad(posterior.z());
-  Cov3 posterior_cov = prior_cov - k_gain * s * k_gain.transpose();  // eq. 22
-  posterior_cov = symmetrized(posterior_cov);
-  if (Eigen::LLT<Cov3>(posterior_cov).info() != Eigen::Success)
-    return InputResult::rejected(Rejection::kCovarianceNotPositiveDefinite);
-  mean_ = posterior;
-  covariance_ = posterior_cov;
+  const StackedModel<ModelList<RangeModel>, LaserBeamModel> model(
+      std::move(beacon_ranges), LaserBeamModel(grid_, scan ? scan->beams : LaserBeams{}, laser_variance_m2));
+  Eigen::VectorXd z(n_b + n_w);
+  for (int k = 0; k < n_b; ++k) z(k) = ranges[k].range_m;
+  for (int k = 0; k < n_w; ++k) z(n_b + k) = scan->ranges_m[k];
+  const UpdateResult corrected_by = filter_.update(*points, model, z);  // eq. 15-22
+  if (!corrected_by.applied()) return InputResult::of(corrected_by.outcome);
   corrected(*now_ns());
   for (int k = 0; k < n_b; ++k) {
     // For evaluation against a simulator's truth; bounded, as no one may ever ask.
     if (associations_.size() >= 4096) associations_.erase(associations_.begin());
-    associations_.push_back({ranges[k].stamp_ns, ranges[k].receiver_id, associated[k]});
+    associations_.push_back({ranges[k].stamp_ns, ranges[k].receiver_id, (*associated)[k]});
   }
   return InputResult::ok();
+}
+
+std::optional<std::vector<std::uint32_t>> UkfLrf::associate(const std::vector<RangeMeasurement>& ranges,
+                                                            const SigmaPoints<3>& points) const {
+  if (ranges.empty()) return std::vector<std::uint32_t>{};
+  // Lines 1-5: the predicted range to every beacon over the sigma points, its mean and variance.
+  const Eigen::MatrixXd& states = points.states();
+  const UnscentedWeights& w = points.weights();
+  const Eigen::Index count = states.cols();
+  std::vector<PredictedBeaconRange> predicted;
+  for (const Beacon& b : map().beacons()) {
+    Eigen::VectorXd z(count);
+    for (Eigen::Index i = 0; i < count; ++i) {
+      z(i) = i > 0 && states.col(i) == states.col(0)
+                 ? z(0)
+                 : predict_range(Pose2(states.col(i)), receiver_base_m_, receiver_height_m_, b.position_map_m).range_m;
+    }
+    const double mean_z = z.dot(w.mean);  // line 3
+    const Eigen::RowVectorXd centred = (z.array() - mean_z).matrix().transpose();
+    const double var_z = (centred * w.covariance.asDiagonal() * centred.transpose())(0, 0) +
+                         params_.beacon_sigma_m * params_.beacon_sigma_m;  // line 4, with its noise (line 2)
+    predicted.push_back({b.id, mean_z, var_z});
+  }
+  std::vector<std::uint32_t> out;
+  for (const RangeMeasurement& r : ranges) {
+    const auto j = most_likely_beacon(r.range_m, predicted);  // lines 6-11
+    if (!j) return std::nullopt;
+    out.push_back(*j);
+  }
+  return out;
 }
 
 std::vector<Estimator::Association> UkfLrf::take_associations() {
@@ -342,10 +295,8 @@ std::vector<Estimator::Association> UkfLrf::take_associations() {
 }
 
 bool UkfLrf::place(const Pose2& pose, const Cov3& covariance) {
-  mean_ = pose;  // placed by hand again (Sec. 4.1)
-  mean_.z() = wrap_angle_rad(mean_.z());
-  covariance_ = covariance;
-  return true;
+  // Placed by hand again (Sec. 4.1): a pose the base checked.
+  return filter_.reset(pose, covariance) == FilterOutcome::kApplied;
 }
 
 namespace {

@@ -14,8 +14,9 @@
 
 #include "beacon_association.hpp"
 #include "beaconloc/core/estimator_base.hpp"
-#include "beaconloc/core/filters/unscented.hpp"
+#include "beaconloc/core/filters/ukf.hpp"
 #include "beaconloc/core/models/laser_beam_model.hpp"
+#include "beaconloc/core/models/velocity_motion.hpp"
 
 namespace beaconloc::ukf_lrf {
 
@@ -56,7 +57,7 @@ class UkfLrf final : public EstimatorBase {
 
  private:
   UkfLrf(const EstimatorConfig& config, Mode mode, const UkfLrfParameters& params);
-  PoseBelief pose_belief() const override { return {mean_, covariance_}; }
+  PoseBelief pose_belief() const override { return {filter_.state(), filter_.covariance()}; }
   // Placed by hand (Sec. 4.1): until then it waits for that, whatever else it has.
   StartupWait waiting_for() const override { return {StartupCondition::kNeedsInitialPose, 0.0, 0.0, {}}; }
   bool needs_beacon_map() const override { return false; }
@@ -68,8 +69,13 @@ class UkfLrf final : public EstimatorBase {
     LaserBeams beams;
     std::vector<double> ranges_m;
   };
-  // One iteration of Table 1: sigma points of the augmented state, the motion of eq. 9-11 (when
-  // there is one) and the correction with the measurements given (the missing terms dropped).
+  // Table 2: the most likely beacon of each range over the sigma points; nullopt when a range
+  // has none.
+  std::optional<std::vector<std::uint32_t>> associate(const std::vector<RangeMeasurement>& ranges,
+                                                      const SigmaPoints<3>& points) const;
+  // One iteration of Table 1: one set of sigma points of the augmented state, the motion of
+  // eq. 9-11 (when there is one) and the correction with the measurements given (the missing
+  // terms dropped).
   InputResult step(std::optional<Motion> motion, std::vector<RangeMeasurement> ranges, const ScanBeams* scan);
   InputResult fuse_or_hold(std::vector<RangeMeasurement> ranges, std::optional<ScanBeams> beams,
                            StampNs stamp_ns);
@@ -80,8 +86,8 @@ class UkfLrf final : public EstimatorBase {
   std::shared_ptr<const OccupancyGrid> grid_;
   Eigen::Vector2d receiver_base_m_ = Eigen::Vector2d::Zero();
   double receiver_height_m_ = 0.0;
-  Pose2 mean_ = Pose2::Zero();
-  Cov3 covariance_ = Cov3::Identity();
+  VelocityMotion motion_model_;  // eq. 6, 9-11
+  Ukf<3> filter_;                // eq. 1-5, 12-22 on [x, y, theta]
   std::vector<RangeMeasurement> pending_ranges_;  // stamped after the filter's time
   std::optional<ScanBeams> pending_scan_;
   StampNs pending_scan_stamp_ns_ = 0;

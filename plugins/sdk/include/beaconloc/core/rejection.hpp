@@ -52,6 +52,7 @@ enum class Rejection : std::uint8_t {
   kHInfinityBoundNotMet,
   kNonFiniteModel,
   kSizeMismatch,
+  kStaleSigmaPoints,
   // Placing an estimator.
   kNoInitialPose,
   kResetUnsupported,

@@ -34,7 +34,7 @@ class DiagnosticsPublisher {
  private:
   const Participant& participant_;
   std::function<msg::Diagnostics()> snapshot_;
-  eprosima::fastdds::dds::DataWriter* writer_;
+  Writer writer_;
   std::unique_ptr<PeriodicTask> task_;
 };
 

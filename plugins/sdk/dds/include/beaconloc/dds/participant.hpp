@@ -1,6 +1,7 @@
 #pragma once
-// A DomainParticipant with its publisher and subscriber, created from the XML profiles. Owns and
-// deletes every entity it creates. Thin: no logic beyond creating entities with named QoS.
+// A DomainParticipant with its publisher and subscriber, created from the XML profiles, and the
+// owning handles (Writer, Reader) of the entities it creates. Thin: no logic beyond creating
+// entities with named QoS.
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -14,6 +15,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <functional>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -144,6 +146,56 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
 bool wait_for_matched_readers(const std::vector<eprosima::fastdds::dds::DataWriter*>& writers,
                               std::chrono::milliseconds timeout);
 
+// A DataWriter or DataReader this code owns (RAII): deleted when its handle goes, a reader after
+// any callback under way has returned, and then its listener (when the handle owns it). A class
+// declares its participant first, the state its callbacks use next, and its handles last, so that
+// the readers stop before anything they use is destroyed, with no destructor to write. Move-only.
+// A handle must not outlive its participant: ~Participant aborts, naming it, if one does.
+class Writer {
+ public:
+  Writer() = default;
+  Writer(Writer&& other) noexcept { *this = std::move(other); }
+  Writer& operator=(Writer&& other) noexcept;
+  Writer(const Writer&) = delete;
+  Writer& operator=(const Writer&) = delete;
+  ~Writer() { reset(); }
+  eprosima::fastdds::dds::DataWriter* get() const { return writer_; }
+  eprosima::fastdds::dds::DataWriter* operator->() const { return writer_; }
+  explicit operator bool() const { return writer_ != nullptr; }
+  void reset();
+
+ private:
+  friend class Participant;
+  Writer(eprosima::fastdds::dds::Publisher* publisher, eprosima::fastdds::dds::DataWriter* writer,
+         std::atomic<int>* live);
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
+  std::atomic<int>* live_ = nullptr;  // the participant's count of handles
+};
+
+class Reader {
+ public:
+  Reader() = default;
+  Reader(Reader&& other) noexcept { *this = std::move(other); }
+  Reader& operator=(Reader&& other) noexcept;
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+  ~Reader() { reset(); }
+  eprosima::fastdds::dds::DataReader* get() const { return reader_; }
+  eprosima::fastdds::dds::DataReader* operator->() const { return reader_; }
+  explicit operator bool() const { return reader_ != nullptr; }
+  void reset();
+
+ private:
+  friend class Participant;
+  Reader(eprosima::fastdds::dds::Subscriber* subscriber, eprosima::fastdds::dds::DataReader* reader,
+         std::unique_ptr<eprosima::fastdds::dds::DataReaderListener> listener, std::atomic<int>* live);
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+  std::unique_ptr<eprosima::fastdds::dds::DataReaderListener> listener_;  // when the handle owns it
+  std::atomic<int>* live_ = nullptr;
+};
+
 class Participant {
  public:
   Participant(const DdsOptions& options, const std::string& name);
@@ -152,25 +204,22 @@ class Participant {
   Participant& operator=(const Participant&) = delete;
 
   template <class PubSubType>
-  eprosima::fastdds::dds::DataWriter* writer(const TopicSpec& spec,
-                                             eprosima::fastdds::dds::DataWriterListener* listener = nullptr) {
+  [[nodiscard]] Writer writer(const TopicSpec& spec, eprosima::fastdds::dds::DataWriterListener* listener = nullptr) {
     return make_writer(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.writer_profile,
                        listener);
   }
   // Subscribes with the topic's reader profile; on_sample runs on the reader's thread for each
-  // valid sample. The participant owns the listener; close() before what on_sample uses dies.
+  // valid sample, until the handle goes (which owns the listener).
   template <class PubSubType>
-  eprosima::fastdds::dds::DataReader* subscribe(
-      const TopicSpec& spec, std::function<void(const typename PubSubType::type&)> on_sample,
-      std::atomic<std::uint64_t>* deadline_misses = nullptr) {
+  [[nodiscard]] Reader subscribe(const TopicSpec& spec, std::function<void(const typename PubSubType::type&)> on_sample,
+                                 std::atomic<std::uint64_t>* deadline_misses = nullptr) {
     ReaderEvents<typename PubSubType::type> events;
     events.deadline_misses = deadline_misses;
     return subscribe<PubSubType>(spec, std::move(on_sample), std::move(events));
   }
   template <class PubSubType>
-  eprosima::fastdds::dds::DataReader* subscribe(
-      const TopicSpec& spec, std::function<void(const typename PubSubType::type&)> on_sample,
-      ReaderEvents<typename PubSubType::type> events) {
+  [[nodiscard]] Reader subscribe(const TopicSpec& spec, std::function<void(const typename PubSubType::type&)> on_sample,
+                                 ReaderEvents<typename PubSubType::type> events) {
     return subscribe_with_info<PubSubType>(
         spec,
         [on_sample = std::move(on_sample)](const typename PubSubType::type& m,
@@ -179,35 +228,32 @@ class Participant {
   }
   // The same, with each sample's SampleInfo (its writer: publication_handle).
   template <class PubSubType>
-  eprosima::fastdds::dds::DataReader* subscribe_with_info(
-      const TopicSpec& spec, typename SampleListener<typename PubSubType::type>::OnSample on_sample,
-      ReaderEvents<typename PubSubType::type> events = {}) {
-    listeners_.push_back(
-        std::make_unique<SampleListener<typename PubSubType::type>>(std::move(on_sample), std::move(events)));
-    return reader<PubSubType>(spec, listeners_.back().get());
-  }
-  // A reader with a listener of the caller's, who keeps it alive until close().
-  template <class PubSubType>
-  eprosima::fastdds::dds::DataReader* reader(const TopicSpec& spec,
-                                             eprosima::fastdds::dds::DataReaderListener* listener) {
+  [[nodiscard]] Reader subscribe_with_info(const TopicSpec& spec,
+                                           typename SampleListener<typename PubSubType::type>::OnSample on_sample,
+                                           ReaderEvents<typename PubSubType::type> events = {}) {
     return make_reader(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.reader_profile,
-                       listener);
+                       std::make_unique<SampleListener<typename PubSubType::type>>(std::move(on_sample),
+                                                                                   std::move(events)),
+                       nullptr);
+  }
+  // A reader with a listener of the caller's, which must outlive the handle (declared before it).
+  template <class PubSubType>
+  [[nodiscard]] Reader reader(const TopicSpec& spec, eprosima::fastdds::dds::DataReaderListener* listener) {
+    return make_reader(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.reader_profile,
+                       nullptr, listener);
   }
   const std::string& name() const { return name_; }
   // Samples whose payload could not be read, on any topic (Fast DDS dropped them).
   std::uint64_t undecodable_samples() const { return undecodable_.load(); }
-  // Deletes the readers (each waits for a callback under way), then the writers: call before the
-  // listeners they use are destroyed.
-  void close();
 
  private:
   eprosima::fastdds::dds::Topic* topic(const std::string& name, eprosima::fastdds::dds::TopicDataType* type);
-  eprosima::fastdds::dds::DataWriter* make_writer(eprosima::fastdds::dds::Topic* topic,
-                                                  const std::string& profile,
-                                                  eprosima::fastdds::dds::DataWriterListener* l);
-  eprosima::fastdds::dds::DataReader* make_reader(eprosima::fastdds::dds::Topic* topic,
-                                                  const std::string& profile,
-                                                  eprosima::fastdds::dds::DataReaderListener* l);
+  Writer make_writer(eprosima::fastdds::dds::Topic* topic, const std::string& profile,
+                     eprosima::fastdds::dds::DataWriterListener* l);
+  // owned: the listener the handle keeps; else borrowed, the caller's.
+  Reader make_reader(eprosima::fastdds::dds::Topic* topic, const std::string& profile,
+                     std::unique_ptr<eprosima::fastdds::dds::DataReaderListener> owned,
+                     eprosima::fastdds::dds::DataReaderListener* borrowed);
 
   std::string name_;
   std::atomic<std::uint64_t> undecodable_{0};  // counted by the types this participant registers
@@ -215,7 +261,15 @@ class Participant {
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
-  std::vector<std::unique_ptr<eprosima::fastdds::dds::DataReaderListener>> listeners_;
+  std::atomic<int> live_handles_{0};  // Writers and Readers not yet reset
 };
+
+// Waits until every writer has at least one matched reader; false on timeout.
+inline bool wait_for_matched_readers(std::initializer_list<std::reference_wrapper<const Writer>> writers,
+                                     std::chrono::milliseconds timeout) {
+  std::vector<eprosima::fastdds::dds::DataWriter*> raw;
+  for (const Writer& w : writers) raw.push_back(w.get());
+  return wait_for_matched_readers(raw, timeout);
+}
 
 }  // namespace beaconloc::dds

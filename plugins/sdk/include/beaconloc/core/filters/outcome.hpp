@@ -13,6 +13,7 @@ enum class FilterOutcome : std::uint8_t {
   kBoundNotMet,         // H-infinity: P^-1 - theta I + H^T R^-1 H is not positive definite
   kNonFinite,           // the model gave a non-finite prediction, Jacobian or noise
   kSizeMismatch,        // z, R or the Jacobian do not have the model's or the state's size
+  kStaleSigmaPoints,    // UKF: sigma points drawn for another belief or another R (ukf.hpp)
 };
 const char* to_string(FilterOutcome outcome);
 

@@ -10,10 +10,15 @@
 //    augmented as seed 001 eq. 16 does (UkfOptions::augment_measurement_noise: sigma points over
 //    [x; v], z_i = h(x_i) + v_i). The gain from a checked LDLT of S (seed 003 ERRATA: K = P_xz
 //    S^-1), P = P - K S K^T checked positive definite: otherwise nothing changes.
+//  - One iteration of seed 001 Table 1 draws ONE set of sigma points over [x; w_u; v] for both:
+//    predict(motion, u, dt, R) moves them and keeps them (SigmaPoints), the caller may look at the
+//    moved points (seed 001 Table 2 associates beacons over them), and update(points, model, z)
+//    corrects with the same points. sigma_points(R) draws such a set without a motion.
 // Sizes of the augmented sets are known at run time only: dynamic Eigen types inside.
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "beaconloc/core/filters/gaussian_filter.hpp"
 #include "beaconloc/core/filters/unscented.hpp"
@@ -23,6 +28,33 @@ namespace beaconloc {
 struct UkfOptions {
   UnscentedParameters unscented;
   bool augment_measurement_noise = false;
+};
+
+template <int N>
+class Ukf;
+
+// The sigma points of one iteration of the UKF, drawn by Ukf::predict(motion, u, dt, R) or
+// Ukf::sigma_points(R): valid for the belief they were drawn at and the noise R they spread.
+template <int N>
+class SigmaPoints {
+ public:
+  // The points' states (n x (2L + 1)), moved by the motion when there was one.
+  const Eigen::MatrixXd& states() const { return states_; }
+  const UnscentedWeights& weights() const { return weights_; }
+
+ private:
+  friend class Ukf<N>;
+  explicit SigmaPoints(UnscentedWeights weights) : weights_(std::move(weights)) {}
+  UnscentedWeights weights_;
+  Eigen::MatrixXd states_;
+  // The augmented points as drawn ([x; w_u; v] x (2L + 1)): their last measurement_rows_ rows are
+  // each point's measurement noise, the augmented part of seed 001 eq. 8 (chi_n); none when R
+  // is added to S instead. Kept whole, not copied out.
+  Eigen::MatrixXd augmented_;
+  Eigen::Index measurement_rows_ = 0;
+  Eigen::MatrixXd r_;  // the R they spread (augmented) or are to add
+  Vec<N> mean_;        // the belief they spread: the filter's when they were drawn
+  Mat<N, N> covariance_;
 };
 
 template <int N>
@@ -36,95 +68,139 @@ class Ukf : public GaussianFilter<N> {
 
   template <class Motion>
   PredictResult predict(const Motion& motion, const typename Motion::Input& u, double dt_s) {
+    return predict(motion, u, dt_s, Eigen::MatrixXd(0, 0)).result;
+  }
+
+  struct Predicted {
+    PredictResult result;
+    std::optional<SigmaPoints<N>> points;  // when applied
+  };
+  // Seed 001 Table 1: sigma points of [x; w_u; v] (eq. 1-8), v ~ N(0, measurement_noise) the
+  // noise of the correction to follow (0 x 0: none), each moved x (+) dx(x, u + w_u) (eq. 9-11);
+  // the prior (eq. 12-13) replaces the belief, and the moved points are kept for that correction.
+  // A motion with additive state noise Q has its points drawn again from the prior (Q in it), as
+  // a moved set does not spread Q (no points, the prediction applied, when that draw fails).
+  template <class Motion>
+  Predicted predict(const Motion& motion, const typename Motion::Input& u, double dt_s,
+                    const Eigen::MatrixXd& measurement_noise) {
     const Eigen::Index n = this->x_.size();
     const Eigen::Index n_u = Motion::kInputSize;
     const Eigen::MatrixXd input_noise = motion.input_noise(u);
-    if (!input_noise.allFinite() || !u.allFinite()) return {FilterOutcome::kNonFinite};
-    const Eigen::Index l = n + n_u;
-    if (!defined_for(l)) return {FilterOutcome::kNotPositiveDefinite};
-    Eigen::VectorXd mean_a = Eigen::VectorXd::Zero(l);
-    mean_a.head(n) = this->x_;
-    Eigen::MatrixXd cov_a = Eigen::MatrixXd::Zero(l, l);
-    cov_a.topLeftCorner(n, n) = this->p_;
-    cov_a.bottomRightCorner(n_u, n_u) = input_noise;
-    const UnscentedWeights w(l, options_.unscented);
-    const auto chi = sigma_points(mean_a, cov_a, w);
-    if (!chi) return {FilterOutcome::kNotPositiveDefinite};
-    Eigen::MatrixXd moved(n, chi->cols());
-    for (Eigen::Index i = 0; i < chi->cols(); ++i) {
-      const State xi = chi->col(i).head(n);
-      const typename Motion::Input ui = u + chi->col(i).tail(n_u);
+    if (!input_noise.allFinite() || !u.allFinite() || !measurement_noise.allFinite()) {
+      return {{FilterOutcome::kNonFinite}, std::nullopt};
+    }
+    std::optional<SigmaPoints<N>> points = draw(input_noise, measurement_noise);
+    if (!points) return {{FilterOutcome::kNotPositiveDefinite}, std::nullopt};
+    const Eigen::MatrixXd& chi = points->augmented_;
+    Eigen::MatrixXd moved(n, chi.cols());
+    for (Eigen::Index i = 0; i < chi.cols(); ++i) {
+      // A point that spreads only measurement noise moves as the first: no second motion step.
+      if (i > 0 && chi.col(i).head(n + n_u) == chi.col(0).head(n + n_u)) {
+        moved.col(i) = moved.col(0);
+        continue;
+      }
+      const State xi = chi.col(i).head(n);
+      const typename Motion::Input ui = u + chi.col(i).segment(n, n_u);
       moved.col(i) = this->space_.plus(xi, motion.step(xi, ui, dt_s));
     }
-    if (!moved.allFinite()) return {FilterOutcome::kNonFinite};
+    if (!moved.allFinite()) return {{FilterOutcome::kNonFinite}, std::nullopt};
     State mean;
     Eigen::MatrixXd centred;
-    state_moments(moved, w, mean, centred);
-    Covariance p = weighted_cross_covariance(centred, centred, w);
+    state_moments(moved, points->weights_, mean, centred);
+    Covariance p = weighted_cross_covariance(centred, centred, points->weights_);
     if constexpr (Motion::kHasStateNoise) p += motion.template state_noise<N>(n, dt_s);
-    if (!p.allFinite()) return {FilterOutcome::kNonFinite};
+    if (!p.allFinite()) return {{FilterOutcome::kNonFinite}, std::nullopt};
     this->x_ = mean;
     this->p_ = symmetrized(p);
-    return {};
+    if constexpr (Motion::kHasStateNoise) {
+      points = sigma_points(measurement_noise);
+      if (!points) return {{FilterOutcome::kApplied}, std::nullopt};  // predicted; no correction possible
+    } else {
+      points->states_ = std::move(moved);
+      points->mean_ = this->x_;
+      points->covariance_ = this->p_;
+    }
+    return {{}, std::move(points)};
+  }
+
+  // Sigma points of the belief as it is, for a correction whose noise R = measurement_noise is
+  // augmented (seed 001 eq. 16); nullopt when the augmented covariance is not positive definite.
+  std::optional<SigmaPoints<N>> sigma_points(const Eigen::MatrixXd& measurement_noise) const {
+    if (!measurement_noise.allFinite()) return std::nullopt;
+    return draw(Eigen::MatrixXd(0, 0), measurement_noise);
   }
 
   template <class Model>
   UpdateResult update(const Model& model, const typename Model::Vector& z,
+                      double nis_gate = std::numeric_limits<double>::infinity()) {
+    const Eigen::MatrixXd r = model.noise();
+    UpdateResult result;
+    result.iterations = 1;
+    result.outcome = this->check_measurement(model, z, r);
+    if (!result.applied()) return result;
+    std::optional<SigmaPoints<N>> points = options_.augment_measurement_noise ? sigma_points(r) : draw_additive(r);
+    if (!points) {
+      result.outcome = FilterOutcome::kNotPositiveDefinite;
+      return result;
+    }
+    return update(*points, model, z, nis_gate);
+  }
+
+  // Seed 001 eq. 15-22 over points drawn for this belief: z_i = h(x_i) (+ v_i, eq. 16), their
+  // mean and S (eq. 18-19, + R when not augmented), P_xz (eq. 20), K = P_xz S^-1, the posterior
+  // (eq. 21-22). kStaleSigmaPoints when the belief or R is not the one they were drawn for.
+  template <class Model>
+  UpdateResult update(const SigmaPoints<N>& points, const Model& model, const typename Model::Vector& z,
                       double nis_gate = std::numeric_limits<double>::infinity()) {
     UpdateResult result;
     result.iterations = 1;
     const Eigen::MatrixXd r = model.noise();
     result.outcome = this->check_measurement(model, z, r);
     if (!result.applied()) return result;
+    if (!same(points.mean_, this->x_) || !same(points.covariance_, this->p_) || !same(points.r_, r)) {
+      result.outcome = FilterOutcome::kStaleSigmaPoints;
+      return result;
+    }
     const Eigen::Index n = this->x_.size(), m = model.size();
-    const bool augmented = options_.augment_measurement_noise;
-    const Eigen::Index l = augmented ? n + m : n;
-    if (!defined_for(l)) {
-      result.outcome = FilterOutcome::kNotPositiveDefinite;
-      return result;
-    }
-    Eigen::VectorXd mean_a = Eigen::VectorXd::Zero(l);
-    mean_a.head(n) = this->x_;
-    Eigen::MatrixXd cov_a = Eigen::MatrixXd::Zero(l, l);
-    cov_a.topLeftCorner(n, n) = this->p_;
-    if (augmented) cov_a.bottomRightCorner(m, m) = r;
-    const UnscentedWeights w(l, options_.unscented);
-    const auto chi = sigma_points(mean_a, cov_a, w);
-    if (!chi) {
-      result.outcome = FilterOutcome::kNotPositiveDefinite;
-      return result;
-    }
-    const Eigen::Index count = chi->cols();
+    const Eigen::MatrixXd& states = points.states_;
+    const UnscentedWeights& w = points.weights_;
+    const bool augmented = points.measurement_rows_ > 0;
+    const Eigen::Index count = states.cols();
     Eigen::MatrixXd z_sigma(m, count);
     for (Eigen::Index i = 0; i < count; ++i) {
-      // A point that spreads only measurement noise keeps the mean's state: its h is the first
+      // A point that spreads only measurement noise keeps the first's state: its h is the first
       // point's (exact, and no second ray cast or solve).
-      if (i > 0 && chi->col(i).head(n) == chi->col(0).head(n)) {
+      if (i > 0 && states.col(i) == states.col(0)) {
         z_sigma.col(i) = z_sigma.col(0);
       } else {
-        const State xi = chi->col(i).head(n);
-        z_sigma.col(i) = model.predict(xi);
+        predict_into(model, State(states.col(i)), z_sigma.col(i));
       }
     }
     if (!z_sigma.allFinite()) {
       result.outcome = FilterOutcome::kNonFinite;
       return result;
     }
-    if (augmented) z_sigma += chi->bottomRows(m);  // seed 001 eq. 16: + chi_n
-    // The measurement's mean as offsets from the first point (angle-aware through the residual).
-    const typename Model::Vector z0 = z_sigma.col(0);
-    Eigen::MatrixXd z_offsets(m, count);
-    for (Eigen::Index i = 0; i < count; ++i) {
-      z_offsets.col(i) = model.residual(typename Model::Vector(z_sigma.col(i)), z0);
-    }
-    const typename Model::Vector z_mean = z0 + typename Model::Vector(weighted_mean(z_offsets, w));
+    if (augmented) z_sigma += points.augmented_.bottomRows(points.measurement_rows_);  // eq. 16: + chi_n
+    typename Model::Vector z_mean;
     Eigen::MatrixXd z_centred(m, count);
-    for (Eigen::Index i = 0; i < count; ++i) {
-      z_centred.col(i) = model.residual(typename Model::Vector(z_sigma.col(i)), z_mean);
+    if constexpr (plain_residual_v<Model>) {
+      z_mean = weighted_mean(z_sigma, w);  // eq. 18
+      z_centred = z_sigma.colwise() - Eigen::VectorXd(z_mean);
+    } else {
+      // The mean as offsets from the first point (angle-aware through the residual).
+      const typename Model::Vector z0 = z_sigma.col(0);
+      Eigen::MatrixXd z_offsets(m, count);
+      for (Eigen::Index i = 0; i < count; ++i) {
+        z_offsets.col(i) = model.residual(typename Model::Vector(z_sigma.col(i)), z0);
+      }
+      z_mean = z0 + typename Model::Vector(weighted_mean(z_offsets, w));
+      for (Eigen::Index i = 0; i < count; ++i) {
+        z_centred.col(i) = model.residual(typename Model::Vector(z_sigma.col(i)), z_mean);
+      }
     }
     Eigen::MatrixXd x_centred(n, count);
     for (Eigen::Index i = 0; i < count; ++i) {
-      x_centred.col(i) = this->space_.minus(State(chi->col(i).head(n)), this->x_);
+      x_centred.col(i) = this->space_.minus(State(states.col(i)), this->x_);
     }
     Eigen::MatrixXd s = weighted_cross_covariance(z_centred, z_centred, w);
     if (!augmented) s += r;
@@ -152,10 +228,44 @@ class Ukf : public GaussianFilter<N> {
   }
 
  private:
+  template <class A, class B>
+  static bool same(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>& b) {
+    return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
+  }
   // The transform needs L + lambda = alpha^2 (L + kappa) > 0.
   bool defined_for(Eigen::Index l) const {
     const UnscentedParameters& p = options_.unscented;
     return l >= 1 && p.alpha * p.alpha * (static_cast<double>(l) + p.kappa) > 0.0;
+  }
+  // Sigma points (eq. 2) of the belief augmented with zero-mean noises (eq. 4-5, 7): the input's
+  // and the measurement's, block-diagonal; the augmented points kept whole, for predict to
+  // move (the measurement's rows last). nullopt when not positive definite.
+  std::optional<SigmaPoints<N>> draw(const Eigen::MatrixXd& input_noise, const Eigen::MatrixXd& measurement_noise) const {
+    const Eigen::Index n = this->x_.size(), n_u = input_noise.rows(), m = measurement_noise.rows();
+    const Eigen::Index l = n + n_u + m;
+    if (!defined_for(l)) return std::nullopt;
+    Eigen::VectorXd mean_a = Eigen::VectorXd::Zero(l);
+    mean_a.head(n) = this->x_;
+    Eigen::MatrixXd cov_a = Eigen::MatrixXd::Zero(l, l);
+    cov_a.topLeftCorner(n, n) = this->p_;
+    if (n_u > 0) cov_a.block(n, n, n_u, n_u) = input_noise;
+    if (m > 0) cov_a.bottomRightCorner(m, m) = measurement_noise;
+    SigmaPoints<N> points{UnscentedWeights(l, options_.unscented)};
+    std::optional<Eigen::MatrixXd> chi = beaconloc::sigma_points(mean_a, cov_a, points.weights_);
+    if (!chi) return std::nullopt;
+    points.augmented_ = std::move(*chi);
+    points.measurement_rows_ = m;
+    if (n_u == 0) points.states_ = points.augmented_.topRows(n);  // no motion to move them
+    points.r_ = measurement_noise;
+    points.mean_ = this->x_;
+    points.covariance_ = this->p_;
+    return points;
+  }
+  // Sigma points of the belief alone, R to be added to S.
+  std::optional<SigmaPoints<N>> draw_additive(const Eigen::MatrixXd& r) const {
+    std::optional<SigmaPoints<N>> points = draw(Eigen::MatrixXd(0, 0), Eigen::MatrixXd(0, 0));
+    if (points) points->r_ = r;
+    return points;
   }
   // The weighted mean of the columns as offsets from the first (so headings average across
   // +-pi), and the columns centred on it.

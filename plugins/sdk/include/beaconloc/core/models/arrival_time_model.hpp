@@ -29,6 +29,7 @@ class ArrivalTimeModel {
  public:
   static constexpr int kSize = 1;
   static constexpr bool kHasJacobian = true;
+  static constexpr bool kPlainResidual = true;  // z - h: no angle in z
   using Vector = Vec<1>;
 
   ArrivalTimeModel(const Eigen::Vector3d& beacon_map_m, double receiver_z_m, double variance_s2,

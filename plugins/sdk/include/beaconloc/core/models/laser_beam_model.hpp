@@ -27,11 +27,13 @@ void expected_laser_ranges(const OccupancyGrid& grid, const Pose2& pose_map_base
 
 // The beams of one scan as a measurement model (core/models/model_concepts.hpp) on any state
 // holding the pose. A ray cast has no useful derivative (it jumps at every cell edge): the model
-// has no Jacobian, and only the UKF takes it (kHasJacobian = false).
+// has no Jacobian, and only the UKF takes it (kHasJacobian = false). A model of no beams casts
+// no ray (and needs no grid).
 class LaserBeamModel {
  public:
   static constexpr int kSize = Eigen::Dynamic;
   static constexpr bool kHasJacobian = false;
+  static constexpr bool kPlainResidual = true;  // z - h: no angle in z
   using Vector = Eigen::VectorXd;
 
   LaserBeamModel(std::shared_ptr<const OccupancyGrid> grid, LaserBeams beams, double beam_variance_m2,
@@ -42,8 +44,12 @@ class LaserBeamModel {
   template <int N>
   Vector predict(const Vec<N>& x) const {
     Vector out(size());
-    expected_laser_ranges(*grid_, pose_.pose_of(x), beams_, out.data());
+    predict_into(x, out);
     return out;
+  }
+  template <int N>
+  void predict_into(const Vec<N>& x, Eigen::Ref<Eigen::VectorXd> out) const {
+    if (size() > 0) expected_laser_ranges(*grid_, pose_.pose_of(x), beams_, out.data());
   }
   Eigen::MatrixXd noise() const { return variance_m2_ * Eigen::MatrixXd::Identity(size(), size()); }
   Vector residual(const Vector& z, const Vector& h) const { return z - h; }

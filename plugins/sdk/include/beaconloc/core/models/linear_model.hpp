@@ -11,6 +11,7 @@ class LinearModel {
  public:
   static constexpr int kSize = M;
   static constexpr bool kHasJacobian = true;
+  static constexpr bool kPlainResidual = true;  // z - h: no angle in z
   using Vector = Vec<M>;
 
   LinearModel(const Mat<M, N>& h, const Mat<M, M>& r) : h_(h), r_(r) {}

@@ -12,6 +12,12 @@
 //       linearize(const Vec<N>& x) const;                       // h(x) and dh/dx (kHasJacobian)
 //   Mat<kSize, kSize> noise() const;                            // R
 //   Vector residual(const Vector& z, const Vector& h) const;    // z - h, angles wrapped
+//   template <int N> void predict_into(const Vec<N>& x, Eigen::Ref<Eigen::VectorXd> h) const;
+//                                          // optional: h(x) written in place (no allocation; the
+//                                          // UKF calls it once per sigma point)
+//   static constexpr bool kPlainResidual;  // optional: true when residual() is z - h exactly
+//                                          // (no angle in z); the UKF then centres its sigma
+//                                          // points' predictions at once, not one call per point
 //
 // A motion model moves a state by an input u over dt_s. It gives the step dx, and the filter
 // composes x (+) dx in its state space (core/filters/state_space.hpp), so that headings are
@@ -26,9 +32,39 @@
 //   template <int N> Mat<N, N> state_noise(Eigen::Index n, double dt_s) const;        // Q, when kHasStateNoise
 // The EKF's predicted covariance is F P F^T + G U G^T (+ Q); the UKF propagates sigma points of
 // the state augmented with the input noise.
+#include <type_traits>
+#include <utility>
+
 #include "beaconloc/core/filters/state_space.hpp"
 
 namespace beaconloc {
+
+// Model::kPlainResidual, false for a model that does not say.
+template <class Model, class = void>
+struct PlainResidual : std::false_type {};
+template <class Model>
+struct PlainResidual<Model, std::void_t<decltype(Model::kPlainResidual)>>
+    : std::bool_constant<Model::kPlainResidual> {};
+template <class Model>
+inline constexpr bool plain_residual_v = PlainResidual<Model>::value;
+
+// Whether Model has predict_into (for a state of N numbers).
+template <class Model, int N, class = void>
+struct PredictsInPlace : std::false_type {};
+template <class Model, int N>
+struct PredictsInPlace<Model, N,
+                       std::void_t<decltype(std::declval<const Model&>().predict_into(
+                           std::declval<const Vec<N>&>(), std::declval<Eigen::Ref<Eigen::VectorXd>>()))>>
+    : std::true_type {};
+// h(x) into `out` (model.size() numbers): in place where the model can, else a copy of predict().
+template <int N, class Model>
+void predict_into(const Model& model, const Vec<N>& x, Eigen::Ref<Eigen::VectorXd> out) {
+  if constexpr (PredictsInPlace<Model, N>::value) {
+    model.predict_into(x, out);
+  } else {
+    out = model.predict(x);
+  }
+}
 
 template <int M, int N>
 struct MeasurementLinearization {

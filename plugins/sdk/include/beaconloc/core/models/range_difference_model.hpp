@@ -14,6 +14,7 @@ class RangeDifferenceModel {
  public:
   static constexpr int kSize = Eigen::Dynamic;
   static constexpr bool kHasJacobian = true;
+  static constexpr bool kPlainResidual = true;  // z - h: no angle in z
   using Vector = Eigen::VectorXd;
 
   // beacons_map_m: the reference beacon first, then one beacon per difference (at least two in

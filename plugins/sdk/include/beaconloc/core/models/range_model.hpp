@@ -33,6 +33,7 @@ class RangeModel {
  public:
   static constexpr int kSize = 1;
   static constexpr bool kHasJacobian = true;
+  static constexpr bool kPlainResidual = true;  // z - h: no angle in z
   using Vector = Vec<1>;
 
   RangeModel(const Eigen::Vector2d& receiver_base_m, double receiver_z_m, const Eigen::Vector3d& beacon_map_m,
