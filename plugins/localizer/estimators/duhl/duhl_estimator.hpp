@@ -76,7 +76,6 @@ class Duhl final : public EstimatorBase {
   ReceiverRing ring_;
   DuhlParameters params_;
   Ekf<3> ekf_{pose_space()};
-  Ekf<3> distance_filter_;  // eq. 25-27 on one Tx's q^i, set to it at each range (no state of its own)
   std::map<std::uint32_t, TxEstimate> available_;  // T_A and Q (eq. 30)
   bool pending_observation_ = false;
   int consecutive_gated_ = 0;

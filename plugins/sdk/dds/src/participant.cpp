@@ -105,55 +105,8 @@ Participant::~Participant() {
   }
 }
 
-Writer::Writer(Publisher* publisher, DataWriter* writer, std::atomic<int>* live)
-    : publisher_(publisher), writer_(writer), live_(live) {
-  ++*live_;
-}
-
-Writer& Writer::operator=(Writer&& other) noexcept {
-  if (this != &other) {
-    reset();
-    publisher_ = std::exchange(other.publisher_, nullptr);
-    writer_ = std::exchange(other.writer_, nullptr);
-    live_ = std::exchange(other.live_, nullptr);
-  }
-  return *this;
-}
-
-void Writer::reset() {
-  if (!writer_) return;
-  publisher_->delete_datawriter(writer_);
-  writer_ = nullptr;
-  --*live_;
-}
-
-Reader::Reader(Subscriber* subscriber, DataReader* reader, std::unique_ptr<DataReaderListener> listener,
-               std::atomic<int>* live)
-    : subscriber_(subscriber), reader_(reader), listener_(std::move(listener)), live_(live) {
-  ++*live_;
-}
-
-Reader& Reader::operator=(Reader&& other) noexcept {
-  if (this != &other) {
-    reset();
-    subscriber_ = std::exchange(other.subscriber_, nullptr);
-    reader_ = std::exchange(other.reader_, nullptr);
-    listener_ = std::move(other.listener_);
-    live_ = std::exchange(other.live_, nullptr);
-  }
-  return *this;
-}
-
-void Reader::reset() {
-  if (reader_) {
-    // Deleting a reader waits for a callback under way: after this no callback runs, and the
-    // listener (and what its callback uses) may go.
-    subscriber_->delete_datareader(reader_);
-    reader_ = nullptr;
-    --*live_;
-  }
-  listener_.reset();
-}
+void delete_entity(Publisher* parent, DataWriter* entity) { parent->delete_datawriter(entity); }
+void delete_entity(Subscriber* parent, DataReader* entity) { parent->delete_datareader(entity); }
 
 Topic* Participant::topic(const std::string& name, TopicDataType* type) {
   TypeSupport support(type);
@@ -171,7 +124,7 @@ Topic* Participant::topic(const std::string& name, TopicDataType* type) {
 Writer Participant::make_writer(Topic* topic, const std::string& profile, DataWriterListener* listener) {
   DataWriter* w = publisher_->create_datawriter_with_profile(topic, profile, listener);
   if (!w) throw DdsError("cannot create writer on " + topic->get_name() + " with profile " + profile);
-  return Writer(publisher_, w, &live_handles_);
+  return Writer(publisher_, w, nullptr, &live_handles_);
 }
 
 Reader Participant::make_reader(Topic* topic, const std::string& profile, std::unique_ptr<DataReaderListener> owned,

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
@@ -23,6 +24,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "beaconloc/dds/checked_type.hpp"
@@ -146,55 +148,63 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
 bool wait_for_matched_readers(const std::vector<eprosima::fastdds::dds::DataWriter*>& writers,
                               std::chrono::milliseconds timeout);
 
+// Deletes a DataWriter from its publisher, a DataReader from its subscriber (participant.cpp).
+void delete_entity(eprosima::fastdds::dds::Publisher* parent, eprosima::fastdds::dds::DataWriter* entity);
+void delete_entity(eprosima::fastdds::dds::Subscriber* parent, eprosima::fastdds::dds::DataReader* entity);
+
 // A DataWriter or DataReader this code owns (RAII): deleted when its handle goes, a reader after
 // any callback under way has returned, and then its listener (when the handle owns it). A class
 // declares its participant first, the state its callbacks use next, and its handles last, so that
 // the readers stop before anything they use is destroyed, with no destructor to write. Move-only.
 // A handle must not outlive its participant: ~Participant aborts, naming it, if one does.
-class Writer {
+template <class Parent, class Entity, class Listener>
+class OwnedEntity {
  public:
-  Writer() = default;
-  Writer(Writer&& other) noexcept { *this = std::move(other); }
-  Writer& operator=(Writer&& other) noexcept;
-  Writer(const Writer&) = delete;
-  Writer& operator=(const Writer&) = delete;
-  ~Writer() { reset(); }
-  eprosima::fastdds::dds::DataWriter* get() const { return writer_; }
-  eprosima::fastdds::dds::DataWriter* operator->() const { return writer_; }
-  explicit operator bool() const { return writer_ != nullptr; }
-  void reset();
+  OwnedEntity() = default;
+  OwnedEntity(OwnedEntity&& other) noexcept { *this = std::move(other); }
+  OwnedEntity& operator=(OwnedEntity&& other) noexcept {
+    if (this != &other) {
+      reset();
+      parent_ = std::exchange(other.parent_, nullptr);
+      entity_ = std::exchange(other.entity_, nullptr);
+      listener_ = std::move(other.listener_);
+      live_ = std::exchange(other.live_, nullptr);
+    }
+    return *this;
+  }
+  OwnedEntity(const OwnedEntity&) = delete;
+  OwnedEntity& operator=(const OwnedEntity&) = delete;
+  ~OwnedEntity() { reset(); }
+  Entity* get() const { return entity_; }
+  Entity* operator->() const { return entity_; }
+  explicit operator bool() const { return entity_ != nullptr; }
+  // Deletes the entity (a reader waits for a callback under way: after this no callback runs),
+  // then the listener the handle owns, which that callback may have used.
+  void reset() {
+    if (entity_) {
+      delete_entity(parent_, entity_);
+      entity_ = nullptr;
+      --*live_;
+    }
+    listener_.reset();
+  }
 
  private:
   friend class Participant;
-  Writer(eprosima::fastdds::dds::Publisher* publisher, eprosima::fastdds::dds::DataWriter* writer,
-         std::atomic<int>* live);
-  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
-  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
-  std::atomic<int>* live_ = nullptr;  // the participant's count of handles
+  OwnedEntity(Parent* parent, Entity* entity, std::unique_ptr<Listener> listener, std::atomic<int>* live)
+      : parent_(parent), entity_(entity), listener_(std::move(listener)), live_(live) {
+    ++*live_;
+  }
+  Parent* parent_ = nullptr;
+  Entity* entity_ = nullptr;
+  std::unique_ptr<Listener> listener_;  // when the handle owns it
+  std::atomic<int>* live_ = nullptr;    // the participant's count of handles
 };
 
-class Reader {
- public:
-  Reader() = default;
-  Reader(Reader&& other) noexcept { *this = std::move(other); }
-  Reader& operator=(Reader&& other) noexcept;
-  Reader(const Reader&) = delete;
-  Reader& operator=(const Reader&) = delete;
-  ~Reader() { reset(); }
-  eprosima::fastdds::dds::DataReader* get() const { return reader_; }
-  eprosima::fastdds::dds::DataReader* operator->() const { return reader_; }
-  explicit operator bool() const { return reader_ != nullptr; }
-  void reset();
-
- private:
-  friend class Participant;
-  Reader(eprosima::fastdds::dds::Subscriber* subscriber, eprosima::fastdds::dds::DataReader* reader,
-         std::unique_ptr<eprosima::fastdds::dds::DataReaderListener> listener, std::atomic<int>* live);
-  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
-  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
-  std::unique_ptr<eprosima::fastdds::dds::DataReaderListener> listener_;  // when the handle owns it
-  std::atomic<int>* live_ = nullptr;
-};
+using Writer = OwnedEntity<eprosima::fastdds::dds::Publisher, eprosima::fastdds::dds::DataWriter,
+                           eprosima::fastdds::dds::DataWriterListener>;
+using Reader = OwnedEntity<eprosima::fastdds::dds::Subscriber, eprosima::fastdds::dds::DataReader,
+                           eprosima::fastdds::dds::DataReaderListener>;
 
 class Participant {
  public:

@@ -89,7 +89,10 @@ class Ukf : public GaussianFilter<N> {
     if (!input_noise.allFinite() || !u.allFinite() || !measurement_noise.allFinite()) {
       return {{FilterOutcome::kNonFinite}, std::nullopt};
     }
-    std::optional<SigmaPoints<N>> points = draw(input_noise, measurement_noise);
+    // With state noise the points are drawn again from the prior below: these spread no
+    // measurement noise.
+    std::optional<SigmaPoints<N>> points =
+        draw(input_noise, Motion::kHasStateNoise ? Eigen::MatrixXd(0, 0) : measurement_noise);
     if (!points) return {{FilterOutcome::kNotPositiveDefinite}, std::nullopt};
     const Eigen::MatrixXd& chi = points->augmented_;
     Eigen::MatrixXd moved(n, chi.cols());
@@ -143,7 +146,7 @@ class Ukf : public GaussianFilter<N> {
       result.outcome = FilterOutcome::kNotPositiveDefinite;
       return result;
     }
-    return update(*points, model, z, nis_gate);
+    return correct(*points, model, z, r, nis_gate);
   }
 
   // Seed 001 eq. 15-22 over points drawn for this belief: z_i = h(x_i) (+ v_i, eq. 16), their
@@ -161,6 +164,17 @@ class Ukf : public GaussianFilter<N> {
       result.outcome = FilterOutcome::kStaleSigmaPoints;
       return result;
     }
+    return correct(points, model, z, r, nis_gate);
+  }
+
+ private:
+  // The correction of update(points, model, z) once z and R = r are checked and the points are
+  // this belief's, drawn for r.
+  template <class Model>
+  UpdateResult correct(const SigmaPoints<N>& points, const Model& model, const typename Model::Vector& z,
+                       const Eigen::MatrixXd& r, double nis_gate) {
+    UpdateResult result;
+    result.iterations = 1;
     const Eigen::Index n = this->x_.size(), m = model.size();
     const Eigen::MatrixXd& states = points.states_;
     const UnscentedWeights& w = points.weights_;
@@ -227,7 +241,6 @@ class Ukf : public GaussianFilter<N> {
     return result;
   }
 
- private:
   template <class A, class B>
   static bool same(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>& b) {
     return a.rows() == b.rows() && a.cols() == b.cols() && a == b;

@@ -29,7 +29,7 @@ void expected_laser_ranges(const OccupancyGrid& grid, const Pose2& pose_map_base
 // holding the pose. A ray cast has no useful derivative (it jumps at every cell edge): the model
 // has no Jacobian, and only the UKF takes it (kHasJacobian = false). A model of no beams casts
 // no ray (and needs no grid).
-class LaserBeamModel {
+class LaserBeamModel : public PredictsByWritingInPlace<LaserBeamModel> {
  public:
   static constexpr int kSize = Eigen::Dynamic;
   static constexpr bool kHasJacobian = false;
@@ -41,12 +41,6 @@ class LaserBeamModel {
       : grid_(std::move(grid)), beams_(std::move(beams)), variance_m2_(beam_variance_m2), pose_(pose) {}
 
   Eigen::Index size() const { return static_cast<Eigen::Index>(beams_.size()); }
-  template <int N>
-  Vector predict(const Vec<N>& x) const {
-    Vector out(size());
-    predict_into(x, out);
-    return out;
-  }
   template <int N>
   void predict_into(const Vec<N>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     if (size() > 0) expected_laser_ranges(*grid_, pose_.pose_of(x), beams_, out.data());

@@ -66,6 +66,19 @@ void predict_into(const Model& model, const Vec<N>& x, Eigen::Ref<Eigen::VectorX
   }
 }
 
+// For a model of dynamic size that writes h in place: its predict(), from its predict_into()
+// (CRTP: class Model : public PredictsByWritingInPlace<Model>).
+template <class Model>
+struct PredictsByWritingInPlace {
+  template <int N>
+  Eigen::VectorXd predict(const Vec<N>& x) const {
+    const Model& model = static_cast<const Model&>(*this);
+    Eigen::VectorXd out(model.size());
+    model.predict_into(x, out);
+    return out;
+  }
+};
+
 template <int M, int N>
 struct MeasurementLinearization {
   Vec<M> predicted;     // h(x)

@@ -14,7 +14,7 @@
 namespace beaconloc {
 
 template <class Part>
-class ModelList {
+class ModelList : public PredictsByWritingInPlace<ModelList<Part>> {
  public:
   static constexpr int kSize = Eigen::Dynamic;
   static constexpr bool kHasJacobian = Part::kHasJacobian;
@@ -32,12 +32,6 @@ class ModelList {
   const std::vector<Part>& parts() const { return parts_; }
 
   Eigen::Index size() const { return size_; }
-  template <int N>
-  Vector predict(const Vec<N>& x) const {
-    Vector out(size_);
-    predict_into(x, out);
-    return out;
-  }
   template <int N>
   void predict_into(const Vec<N>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     Eigen::Index at = 0;
@@ -91,7 +85,7 @@ class ModelList {
 };
 
 template <class A, class B>
-class StackedModel {
+class StackedModel : public PredictsByWritingInPlace<StackedModel<A, B>> {
  public:
   static constexpr int kSize = Eigen::Dynamic;
   static constexpr bool kHasJacobian = A::kHasJacobian && B::kHasJacobian;
@@ -101,12 +95,6 @@ class StackedModel {
   StackedModel(A first, B second) : first_(std::move(first)), second_(std::move(second)) {}
 
   Eigen::Index size() const { return first_.size() + second_.size(); }
-  template <int N>
-  Vector predict(const Vec<N>& x) const {
-    Vector out(size());
-    predict_into(x, out);
-    return out;
-  }
   template <int N>
   void predict_into(const Vec<N>& x, Eigen::Ref<Eigen::VectorXd> out) const {
     beaconloc::predict_into(first_, x, out.head(first_.size()));
