@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <string>
 
 #include "beaconloc/dds/convert.hpp"
 #include "diagnostics_recorder.hpp"
@@ -122,8 +123,18 @@ TEST_F(BridgeBadInput, NonFiniteSamplesNeverReachRos2) {
             std::any_of(ranges.begin(), ranges.end(), [](const auto& r) { return r.range() == 2.5f; });
         return last_pose && last_range && marker_arrays >= 1;
       },
-      10s))
-      << bridge.log();
+      scaled(10s)))
+      << [&] {
+           // Which kind did not arrive (a range or pose the bridge read later than its 600 ms
+           // lifespan is dropped by DDS, uncounted), and what the bridge counted.
+           std::lock_guard<std::mutex> lock(mutex);
+           std::string seen = "poses at s:";
+           for (const auto& p : poses) seen += " " + std::to_string(p.header().stamp().sec());
+           seen += "; ranges:";
+           for (const auto& r : ranges) seen += " " + std::to_string(r.range());
+           seen += "; marker arrays: " + std::to_string(marker_arrays) + "\n";
+           return seen + bridge.log();
+         }();
   {
     std::lock_guard<std::mutex> lock(mutex);
     EXPECT_EQ(poses.size(), 2u);

@@ -37,6 +37,26 @@ TEST(Unscented, ReproducesTheMomentsOfASquaredGaussian) {
               1e-12);
 }
 
+// Eq. 13 / 19 by rank updates of one triangle: the general product's sum to rounding, exactly
+// symmetric; with the paper's alpha (eq. 23, w_0^(c) > 0 at L = 28) and a small one (w_0^(c) < 0).
+TEST(Unscented, TheSymmetricCovarianceIsTheCrossCovarianceOfAColumnSetWithItself) {
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Random(23, 57);
+  for (const double alpha : {0.6, 0.1}) {
+    const UnscentedWeights w(28, {alpha, 2.0, 0.0});
+    EXPECT_EQ(w.covariance(0) < 0.0, alpha == 0.1);
+    const Eigen::MatrixXd general = weighted_cross_covariance(a, a, w);
+    const Eigen::MatrixXd symmetric = weighted_covariance(a, w);
+    EXPECT_LT((symmetric - general).cwiseAbs().maxCoeff(), 1e-12 * general.cwiseAbs().maxCoeff()) << alpha;
+    EXPECT_EQ(symmetric, symmetric.transpose()) << alpha;
+  }
+  const UnscentedWeights w(28, {0.6, 2.0, 0.0});
+  // Weights that eq. 14 would not give (i >= 1 unequal), or another count of columns: refused.
+  UnscentedWeights altered = w;
+  altered.covariance(5) *= 2.0;
+  EXPECT_THROW(weighted_covariance(a, altered), std::invalid_argument);
+  EXPECT_THROW(weighted_covariance(a.leftCols(56), w), std::invalid_argument);
+}
+
 TEST(Unscented, RefusesACovarianceThatIsNotPositiveDefinite) {
   const UnscentedWeights w(2, {});
   Eigen::MatrixXd p(2, 2);

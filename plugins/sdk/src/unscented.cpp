@@ -40,4 +40,16 @@ Eigen::MatrixXd weighted_cross_covariance(const Eigen::MatrixXd& a, const Eigen:
   return a * w.covariance.asDiagonal() * b.transpose();
 }
 
+Eigen::MatrixXd weighted_covariance(const Eigen::MatrixXd& a, const UnscentedWeights& w) {
+  const Eigen::Index m = a.rows(), count = a.cols();
+  if (count != w.covariance.size() || count < 2) throw std::invalid_argument("weighted_covariance: sizes differ");
+  if (!(w.covariance.tail(count - 1).array() == w.covariance(1)).all()) {
+    throw std::invalid_argument("weighted_covariance: the weights of i >= 1 differ (eq. 14 makes them one number)");
+  }
+  Eigen::MatrixXd lower = Eigen::MatrixXd::Zero(m, m);
+  lower.selfadjointView<Eigen::Lower>().rankUpdate(a.rightCols(count - 1), w.covariance(1));
+  lower.selfadjointView<Eigen::Lower>().rankUpdate(a.col(0), w.covariance(0));
+  return lower.selfadjointView<Eigen::Lower>();
+}
+
 }  // namespace beaconloc

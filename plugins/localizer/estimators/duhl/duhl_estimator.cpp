@@ -136,8 +136,7 @@ InputResult Duhl::update(const RangeMeasurement& r) {
   if (it == available_.end()) it = available_.emplace(r.beacon_id, new_tx_estimate(r)).first;
   // Eq. 25-27 for the one receiver this range is from (R diagonal: one scalar update per
   // receiver is the same as the three at once), Joseph form. The filter is local: it holds no
-  // state of its own between ranges, and on the stack it is in cache (a member of an estimator
-  // touched once per firing was not: +13 % per firing in BM_Duhl_RangeUpdate).
+  // state of its own between ranges (q^i and Q^i live in available_).
   Ekf<3> q_filter;
   q_filter.reset(it->second.q, it->second.covariance);
   Eigen::Matrix<double, 1, 3> h = Eigen::Matrix<double, 1, 3>::Zero();

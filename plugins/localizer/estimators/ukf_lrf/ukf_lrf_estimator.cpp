@@ -218,19 +218,19 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
   Eigen::VectorXd r_diagonal(n_b + n_w);
   r_diagonal.head(n_b).setConstant(beacon_variance_m2);
   r_diagonal.tail(n_w).setConstant(laser_variance_m2);
-  const Eigen::MatrixXd r = r_diagonal.asDiagonal();
+  Eigen::MatrixXd r = r_diagonal.asDiagonal();
 
   // Eq. 1-14: one set of sigma points over [x; n_u; n_B; n_W], moved by the motion (eq. 9-11),
   // the prior kept whatever the correction does.
   std::optional<SigmaPoints<3>> points;
   if (motion) {
     Ukf<3>::Predicted predicted =
-        filter_.predict(motion_model_, Eigen::Vector2d(motion->v_mps, motion->omega_radps), motion->dt_s, r);
+        filter_.predict(motion_model_, Eigen::Vector2d(motion->v_mps, motion->omega_radps), motion->dt_s, std::move(r));
     if (!predicted.result.applied()) return InputResult::of(predicted.result.outcome);
     last_step_predicted_ = true;
     points = std::move(predicted.points);
   } else {
-    points = filter_.sigma_points(r);
+    points = filter_.sigma_points(std::move(r));
   }
   if (n_b + n_w == 0) return InputResult::ok();
   if (!points) return InputResult::rejected(Rejection::kCovarianceNotPositiveDefinite);
@@ -266,7 +266,8 @@ std::optional<std::vector<std::uint32_t>> UkfLrf::associate(const std::vector<Ra
   const UnscentedWeights& w = points.weights();
   const Eigen::Index count = states.cols();
   std::vector<PredictedBeaconRange> predicted;
-  for (const Beacon& b : map().beacons()) {
+  predicted.reserve(map().size());
+  map().for_each([&](const Beacon& b) {
     Eigen::VectorXd z(count);
     for (Eigen::Index i = 0; i < count; ++i) {
       z(i) = i > 0 && states.col(i) == states.col(0)
@@ -278,7 +279,7 @@ std::optional<std::vector<std::uint32_t>> UkfLrf::associate(const std::vector<Ra
     const double var_z = (centred * w.covariance.asDiagonal() * centred.transpose())(0, 0) +
                          params_.beacon_sigma_m * params_.beacon_sigma_m;  // line 4, with its noise (line 2)
     predicted.push_back({b.id, mean_z, var_z});
-  }
+  });
   std::vector<std::uint32_t> out;
   for (const RangeMeasurement& r : ranges) {
     const auto j = most_likely_beacon(r.range_m, predicted);  // lines 6-11

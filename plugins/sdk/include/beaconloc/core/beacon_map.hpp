@@ -74,6 +74,11 @@ class BeaconMap {
   }
   bool empty() const { return beacons_.empty(); }
   std::size_t size() const { return beacons_.size(); }
+  // f(beacon) for every beacon in id order, without the copy beacons() makes.
+  template <class F>
+  void for_each(F&& f) const {
+    for (const auto& entry : beacons_) f(entry.second);
+  }
   std::vector<Beacon> beacons() const {
     std::vector<Beacon> out;
     for (const auto& [id, b] : beacons_) out.push_back(b);

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include "beaconloc/core/filters/gaussian_filter.hpp"
 #include "beaconloc/core/filters/unscented.hpp"
@@ -47,6 +48,7 @@ class SigmaPoints {
   explicit SigmaPoints(UnscentedWeights weights) : weights_(std::move(weights)) {}
   UnscentedWeights weights_;
   Eigen::MatrixXd states_;
+  Eigen::MatrixXd deviations_;  // each state (-) mean_: eq. 13's deviations, which eq. 20 uses again
   // The augmented points as drawn ([x; w_u; v] x (2L + 1)): their last measurement_rows_ rows are
   // each point's measurement noise, the augmented part of seed 001 eq. 8 (chi_n); none when R
   // is added to S instead. Kept whole, not copied out.
@@ -82,7 +84,7 @@ class Ukf : public GaussianFilter<N> {
   // a moved set does not spread Q (no points, the prediction applied, when that draw fails).
   template <class Motion>
   Predicted predict(const Motion& motion, const typename Motion::Input& u, double dt_s,
-                    const Eigen::MatrixXd& measurement_noise) {
+                    Eigen::MatrixXd measurement_noise) {
     const Eigen::Index n = this->x_.size();
     const Eigen::Index n_u = Motion::kInputSize;
     const Eigen::MatrixXd input_noise = motion.input_noise(u);
@@ -91,8 +93,12 @@ class Ukf : public GaussianFilter<N> {
     }
     // With state noise the points are drawn again from the prior below: these spread no
     // measurement noise.
-    std::optional<SigmaPoints<N>> points =
-        draw(input_noise, Motion::kHasStateNoise ? Eigen::MatrixXd(0, 0) : measurement_noise);
+    std::optional<SigmaPoints<N>> points;
+    if constexpr (Motion::kHasStateNoise) {
+      points = draw(input_noise, Eigen::MatrixXd(0, 0));
+    } else {
+      points = draw(input_noise, std::move(measurement_noise));
+    }
     if (!points) return {{FilterOutcome::kNotPositiveDefinite}, std::nullopt};
     const Eigen::MatrixXd& chi = points->augmented_;
     Eigen::MatrixXd moved(n, chi.cols());
@@ -110,16 +116,17 @@ class Ukf : public GaussianFilter<N> {
     State mean;
     Eigen::MatrixXd centred;
     state_moments(moved, points->weights_, mean, centred);
-    Covariance p = weighted_cross_covariance(centred, centred, points->weights_);
+    Covariance p = weighted_covariance(centred, points->weights_);
     if constexpr (Motion::kHasStateNoise) p += motion.template state_noise<N>(n, dt_s);
     if (!p.allFinite()) return {{FilterOutcome::kNonFinite}, std::nullopt};
     this->x_ = mean;
     this->p_ = symmetrized(p);
     if constexpr (Motion::kHasStateNoise) {
-      points = sigma_points(measurement_noise);
+      points = sigma_points(std::move(measurement_noise));
       if (!points) return {{FilterOutcome::kApplied}, std::nullopt};  // predicted; no correction possible
     } else {
       points->states_ = std::move(moved);
+      points->deviations_ = std::move(centred);
       points->mean_ = this->x_;
       points->covariance_ = this->p_;
     }
@@ -128,9 +135,9 @@ class Ukf : public GaussianFilter<N> {
 
   // Sigma points of the belief as it is, for a correction whose noise R = measurement_noise is
   // augmented (seed 001 eq. 16); nullopt when the augmented covariance is not positive definite.
-  std::optional<SigmaPoints<N>> sigma_points(const Eigen::MatrixXd& measurement_noise) const {
+  std::optional<SigmaPoints<N>> sigma_points(Eigen::MatrixXd measurement_noise) const {
     if (!measurement_noise.allFinite()) return std::nullopt;
-    return draw(Eigen::MatrixXd(0, 0), measurement_noise);
+    return draw(Eigen::MatrixXd(0, 0), std::move(measurement_noise));
   }
 
   template <class Model>
@@ -175,7 +182,7 @@ class Ukf : public GaussianFilter<N> {
                        const Eigen::MatrixXd& r, double nis_gate) {
     UpdateResult result;
     result.iterations = 1;
-    const Eigen::Index n = this->x_.size(), m = model.size();
+    const Eigen::Index m = model.size();
     const Eigen::MatrixXd& states = points.states_;
     const UnscentedWeights& w = points.weights_;
     const bool augmented = points.measurement_rows_ > 0;
@@ -212,13 +219,9 @@ class Ukf : public GaussianFilter<N> {
         z_centred.col(i) = model.residual(typename Model::Vector(z_sigma.col(i)), z_mean);
       }
     }
-    Eigen::MatrixXd x_centred(n, count);
-    for (Eigen::Index i = 0; i < count; ++i) {
-      x_centred.col(i) = this->space_.minus(State(states.col(i)), this->x_);
-    }
-    Eigen::MatrixXd s = weighted_cross_covariance(z_centred, z_centred, w);
+    Eigen::MatrixXd s = weighted_covariance(z_centred, w);  // eq. 19
     if (!augmented) s += r;
-    const Eigen::MatrixXd xz = weighted_cross_covariance(x_centred, z_centred, w);
+    const Eigen::MatrixXd xz = weighted_cross_covariance(points.deviations_, z_centred, w);  // eq. 20
     const InnovationFactor<Eigen::Dynamic> factor(s);
     if (!factor.ok()) {
       result.outcome = FilterOutcome::kSingularInnovation;
@@ -230,13 +233,14 @@ class Ukf : public GaussianFilter<N> {
       result.outcome = FilterOutcome::kGated;
       return result;
     }
-    const Eigen::MatrixXd k = factor.solve(xz.transpose()).transpose();
-    const Covariance p = symmetrized(Covariance(this->p_ - k * s * k.transpose()));
+    // K = P_xz S^-1, and K S K^T = P_xz S^-1 P_xz^T = P_xz K^T: one product fewer.
+    const Eigen::MatrixXd k_transposed = factor.solve(xz.transpose());
+    const Covariance p = symmetrized(Covariance(this->p_ - xz * k_transposed));
     if (Eigen::LLT<Covariance>(p).info() != Eigen::Success) {
       result.outcome = FilterOutcome::kNotPositiveDefinite;
       return result;
     }
-    this->x_ = this->space_.plus(this->x_, State(k * innovation));
+    this->x_ = this->space_.plus(this->x_, State(k_transposed.transpose() * innovation));
     this->p_ = p;
     return result;
   }
@@ -253,7 +257,7 @@ class Ukf : public GaussianFilter<N> {
   // Sigma points (eq. 2) of the belief augmented with zero-mean noises (eq. 4-5, 7): the input's
   // and the measurement's, block-diagonal; the augmented points kept whole, for predict to
   // move (the measurement's rows last). nullopt when not positive definite.
-  std::optional<SigmaPoints<N>> draw(const Eigen::MatrixXd& input_noise, const Eigen::MatrixXd& measurement_noise) const {
+  std::optional<SigmaPoints<N>> draw(const Eigen::MatrixXd& input_noise, Eigen::MatrixXd measurement_noise) const {
     const Eigen::Index n = this->x_.size(), n_u = input_noise.rows(), m = measurement_noise.rows();
     const Eigen::Index l = n + n_u + m;
     if (!defined_for(l)) return std::nullopt;
@@ -268,8 +272,14 @@ class Ukf : public GaussianFilter<N> {
     if (!chi) return std::nullopt;
     points.augmented_ = std::move(*chi);
     points.measurement_rows_ = m;
-    if (n_u == 0) points.states_ = points.augmented_.topRows(n);  // no motion to move them
-    points.r_ = measurement_noise;
+    if (n_u == 0) {  // no motion to move them
+      points.states_ = points.augmented_.topRows(n);
+      points.deviations_.resize(n, points.states_.cols());
+      for (Eigen::Index i = 0; i < points.states_.cols(); ++i) {
+        points.deviations_.col(i) = this->space_.minus(State(points.states_.col(i)), this->x_);
+      }
+    }
+    points.r_ = std::move(measurement_noise);
     points.mean_ = this->x_;
     points.covariance_ = this->p_;
     return points;

@@ -32,9 +32,14 @@ std::optional<Eigen::MatrixXd> sigma_points(const Eigen::VectorXd& mean, const E
 // Eq. 12 / 18: the weighted mean of the columns.
 Eigen::VectorXd weighted_mean(const Eigen::MatrixXd& points, const UnscentedWeights& weights);
 
-// Eq. 13 / 19 / 20: sum_i w_i^(c) (a_i - a_mean)(b_i - b_mean)^T over columns already centred
+// Eq. 20: sum_i w_i^(c) (a_i - a_mean)(b_i - b_mean)^T over columns already centred
 // (the caller subtracts its mean, wrapping angles where it must).
 Eigen::MatrixXd weighted_cross_covariance(const Eigen::MatrixXd& a_centred, const Eigen::MatrixXd& b_centred,
                                           const UnscentedWeights& weights);
+
+// Eq. 13 / 19: the same with b = a, symmetric: as the weights of i >= 1 are all one number
+// (eq. 14), w_1 A_r A_r^T + w_0 a_0 a_0^T, each a rank update of one triangle (half the products
+// of the general form), mirrored.
+Eigen::MatrixXd weighted_covariance(const Eigen::MatrixXd& a_centred, const UnscentedWeights& weights);
 
 }  // namespace beaconloc
