@@ -203,6 +203,25 @@ TEST(StackedModel, WithoutAJacobianInAPartTheStackHasNone) {
   EXPECT_EQ(model.noise(), Eigen::MatrixXd::Constant(1, 1, 0.16));
 }
 
+// noise_into (what the UKF builds R with, once per correction) writes what noise() gives: the
+// laser's diagonal, and a stack of ranges and beams block-diagonal, the ranges through noise()
+// (they have no noise_into), the beams in place.
+TEST(StackedModel, ModelsThatWriteTheirNoiseInPlaceWriteWhatTheirNoiseGives) {
+  static_assert(WritesNoiseInPlace<LaserBeamModel>::value && !WritesNoiseInPlace<RangeModel>::value, "");
+  LaserBeams beams;
+  for (int k = 0; k < 3; ++k) beams.add_beam(0.5 * k);
+  const LaserBeamModel laser(nullptr, beams, 0.0025);
+  Eigen::MatrixXd written = Eigen::MatrixXd::Zero(3, 3);
+  noise_into(laser, written);
+  EXPECT_EQ(written, laser.noise());
+  ModelList<RangeModel> ranges({RangeModel({0.0, 0.0}, 0.0, {1.0, 1.0, 2.5}, 0.16),
+                                RangeModel({0.0, 0.0}, 0.0, {2.0, 1.0, 2.5}, 0.09)});
+  const StackedModel<ModelList<RangeModel>, LaserBeamModel> model(ranges, laser);
+  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(5, 5);
+  r.diagonal() << 0.16, 0.09, 0.0025, 0.0025, 0.0025;
+  EXPECT_EQ(model.noise(), r);
+}
+
 // A motion model's F and G against central differences of x (+) dx(x, u).
 // input_step: the difference step on the input (the arc's v / omega cancels digits for a small
 // omega: on a straight line the step must carry omega well away from 0).

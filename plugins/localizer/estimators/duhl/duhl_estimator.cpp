@@ -1,6 +1,7 @@
 #include "duhl_estimator.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "beaconloc/core/estimator_parameters.hpp"
@@ -99,15 +100,17 @@ InputResult Duhl::predict(const OdometrySample& o) {
   for (auto it = available_.begin(); it != available_.end();) {
     const double z = map().find(it->first)->position_map_m.z() - ring_.height_m;
     const DistancePrediction p =
-        predict_distances(it->second.q, z, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
+        predict_distances(it->second.q(), z, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
                           o.wheel_base_m, step.dt_s, ring_);
-    it->second.q = p.q;  // eq. 23
-    it->second.covariance = p.jacobian_q * it->second.covariance * p.jacobian_q.transpose() +
-                            p.jacobian_wheels * u * p.jacobian_wheels.transpose();  // eq. 24
+    // Eq. 23-24. Not applied when q^i or Q^i would not be finite: the Tx is then discarded below.
+    const FilterOutcome predicted =
+        it->second.distances.reset(p.q, p.jacobian_q * it->second.covariance() * p.jacobian_q.transpose() +
+                                            p.jacobian_wheels * u * p.jacobian_wheels.transpose());
     it->second.measurement_covariance =
         p.jacobian_q * it->second.measurement_covariance * p.jacobian_q.transpose();
     // Eq. 31-32: discard a Tx whose distances have grown too uncertain.
-    if (it->second.covariance.diagonal().maxCoeff() > params_.discard_variance_m2) {
+    if (predicted != FilterOutcome::kApplied ||
+        it->second.covariance().diagonal().maxCoeff() > params_.discard_variance_m2) {
       it = available_.erase(it);
     } else {
       ++it;
@@ -125,27 +128,29 @@ InputResult Duhl::update(const RangeMeasurement& r) {
     // carry q^i far from the truth within one firing cycle) is discarded as eq. 31-32 would
     // discard an uncertain one, then initialized anew below. Without this, trajectory 4 lost
     // track on 6 of 10 seeds (E_p RMS 0.24-1.29 m on those).
-    const double innovation_m = r.range_m - it->second.q(r.receiver_id);
-    const double variance_m2 = it->second.covariance(r.receiver_id, r.receiver_id) + r.variance_m2;
+    const double innovation_m = r.range_m - it->second.q()(r.receiver_id);
+    const double variance_m2 = it->second.covariance()(r.receiver_id, r.receiver_id) + r.variance_m2;
     if (innovation_m * innovation_m > params_.distance_innovation_gate * variance_m2) {
       available_.erase(it);
       it = available_.end();
       ++contradicted_txs_;
     }
   }
-  if (it == available_.end()) it = available_.emplace(r.beacon_id, new_tx_estimate(r)).first;
+  if (it == available_.end()) {
+    FilterOutcome outcome = FilterOutcome::kApplied;
+    std::optional<TxEstimate> fresh = new_tx_estimate(r, outcome);
+    if (!fresh) return InputResult::of(outcome);
+    it = available_.emplace(r.beacon_id, std::move(*fresh)).first;
+  }
   // Eq. 25-27 for the one receiver this range is from (R diagonal: one scalar update per
-  // receiver is the same as the three at once), Joseph form. The filter is local: it holds no
-  // state of its own between ranges (q^i and Q^i live in available_).
-  Ekf<3> q_filter;
-  q_filter.reset(it->second.q, it->second.covariance);
-  Eigen::Matrix<double, 1, 3> h = Eigen::Matrix<double, 1, 3>::Zero();
-  h(r.receiver_id) = 1.0;
-  const UpdateResult result =
-      q_filter.update(LinearModel<1, 3>(h, Mat<1, 1>(r.variance_m2)), Vec<1>(r.range_m));
+  // receiver is the same as the three at once), Joseph form, on the Tx's own filter. H = e_l^T
+  // is read from a constant table, not written at a run-time index: such a store, read back at
+  // once as a packet, cannot be forwarded and stalls the update.
+  static const std::array<Mat<1, 3>, 3> kReceiverRow = {Mat<1, 3>(1.0, 0.0, 0.0), Mat<1, 3>(0.0, 1.0, 0.0),
+                                                        Mat<1, 3>(0.0, 0.0, 1.0)};
+  const UpdateResult result = it->second.distances.update(
+      LinearModel<1, 3>(kReceiverRow[r.receiver_id], Mat<1, 1>(r.variance_m2)), Vec<1>(r.range_m));
   if (!result.applied()) return InputResult::of(result.outcome);
-  it->second.q = q_filter.state();
-  it->second.covariance = q_filter.covariance();
   // This receiver's distance now carries the measurement's own variance (eq. 27), and no longer
   // any error shared with the other two.
   DistanceCov& measured = it->second.measurement_covariance;
@@ -156,20 +161,20 @@ InputResult Duhl::update(const RangeMeasurement& r) {
   return InputResult::ok();
 }
 
-Duhl::TxEstimate Duhl::new_tx_estimate(const RangeMeasurement& r) const {
+std::optional<Duhl::TxEstimate> Duhl::new_tx_estimate(const RangeMeasurement& r, FilterOutcome& outcome) const {
   TxEstimate fresh;
   if (has_pose()) {  // eq. 28-29, then eq. 30
     const DistanceInit init =
         initial_distances(ekf_.state(), ekf_.covariance(), map().find(r.beacon_id)->position_map_m, ring_);
-    fresh.q = init.q;
-    fresh.covariance = init.covariance;
+    outcome = fresh.distances.reset(init.q, init.covariance);
   } else {
     // No pose yet: the measured distance stands for the three, the unmeasured ones loosely.
-    fresh.q = Distances::Constant(r.range_m);
-    fresh.covariance = std::pow(params_.unmeasured_sigma_m, 2) * DistanceCov::Identity();
+    outcome = fresh.distances.reset(Distances::Constant(r.range_m),
+                                    std::pow(params_.unmeasured_sigma_m, 2) * DistanceCov::Identity());
   }
+  if (outcome != FilterOutcome::kApplied) return std::nullopt;
   // Until a receiver is measured, everything about its distance came from the pose.
-  fresh.measurement_covariance = fresh.covariance;
+  fresh.measurement_covariance = fresh.covariance();
   return fresh;
 }
 
@@ -188,7 +193,7 @@ Cov3 Duhl::observation_covariance(const std::vector<TxDistances>& txs, const Uhl
   covariances.reserve(available_.size());
   const double reuse = static_cast<double>(available_.size());
   for (const auto& [id, e] : available_) {
-    covariances.push_back(params_.observation_covariance_as_printed ? e.covariance
+    covariances.push_back(params_.observation_covariance_as_printed ? e.covariance()
                                                                     : reuse * e.measurement_covariance);
   }
   return uhl_observation_covariance(txs, z, covariances, params_.uhl) + 1e-9 * Cov3::Identity();
@@ -199,7 +204,7 @@ void Duhl::observe() {
   if (available_.size() < kMinTxs) return;
   std::vector<TxDistances> txs;
   txs.reserve(available_.size());
-  for (const auto& [id, e] : available_) txs.push_back({map().find(id)->position_map_m, e.q});
+  for (const auto& [id, e] : available_) txs.push_back({map().find(id)->position_map_m, e.q()});
   const UhlSolution z = solve_uhl(txs, params_.uhl);
   if (!z.ok) {
     uhl_failure_ = z.failure;

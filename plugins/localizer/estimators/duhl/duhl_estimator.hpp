@@ -63,14 +63,19 @@ class Duhl final : public EstimatorBase {
   StartupWait waiting_for() const override;
   bool place(const Pose2& pose_map_base, const Cov3& covariance) override;
   struct TxEstimate {
-    Distances q;
-    DistanceCov covariance;  // Q^i (eq. 24, 26)
+    // q^i and Q^i (eq. 23-24, 25-27): the belief of this Tx's own Kalman filter, which the
+    // range updates correct in place.
+    Ekf<3> distances;
+    const Distances& q() const { return distances.state(); }
+    const DistanceCov& covariance() const { return distances.covariance(); }
     // The part of Q^i the distance measurements put there (eq. 27's R^q per measured receiver,
     // carried by J_g,q), without the odometry noise of eq. 24 (see observation_covariance).
     DistanceCov measurement_covariance;
   };
   void observe();
-  TxEstimate new_tx_estimate(const RangeMeasurement& range) const;
+  // q^i and Q^i of a Tx not in T_A (eq. 28-30); nullopt (with the filter's outcome) when they
+  // are not finite.
+  std::optional<TxEstimate> new_tx_estimate(const RangeMeasurement& range, FilterOutcome& outcome) const;
   Cov3 observation_covariance(const std::vector<TxDistances>& txs, const UhlSolution& z) const;
 
   ReceiverRing ring_;

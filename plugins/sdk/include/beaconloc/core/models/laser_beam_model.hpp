@@ -46,6 +46,7 @@ class LaserBeamModel : public PredictsByWritingInPlace<LaserBeamModel> {
     if (size() > 0) expected_laser_ranges(*grid_, pose_.pose_of(x), beams_, out.data());
   }
   Eigen::MatrixXd noise() const { return variance_m2_ * Eigen::MatrixXd::Identity(size(), size()); }
+  void noise_into(Eigen::Ref<Eigen::MatrixXd> r) const { r.diagonal().setConstant(variance_m2_); }
   Vector residual(const Vector& z, const Vector& h) const { return z - h; }
 
  private:

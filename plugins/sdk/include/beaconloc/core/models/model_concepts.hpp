@@ -15,6 +15,10 @@
 //   template <int N> void predict_into(const Vec<N>& x, Eigen::Ref<Eigen::VectorXd> h) const;
 //                                          // optional: h(x) written in place (no allocation; the
 //                                          // UKF calls it once per sigma point)
+//   void noise_into(Eigen::Ref<Eigen::MatrixXd> r) const;
+//                                          // optional: R written into r, which is zero on entry
+//                                          // (a block-diagonal model writes its blocks, and no
+//                                          // part allocates a matrix of its own)
 //   static constexpr bool kPlainResidual;  // optional: true when residual() is z - h exactly
 //                                          // (no angle in z); the UKF then centres its sigma
 //                                          // points' predictions at once, not one call per point
@@ -76,6 +80,36 @@ struct PredictsByWritingInPlace {
     Eigen::VectorXd out(model.size());
     model.predict_into(x, out);
     return out;
+  }
+};
+
+// Whether Model has noise_into.
+template <class Model, class = void>
+struct WritesNoiseInPlace : std::false_type {};
+template <class Model>
+struct WritesNoiseInPlace<
+    Model, std::void_t<decltype(std::declval<const Model&>().noise_into(std::declval<Eigen::Ref<Eigen::MatrixXd>>()))>>
+    : std::true_type {};
+// R into `r` (model.size() square, zero on entry): in place where the model can, else a copy of
+// noise().
+template <class Model>
+void noise_into(const Model& model, Eigen::Ref<Eigen::MatrixXd> r) {
+  if constexpr (WritesNoiseInPlace<Model>::value) {
+    model.noise_into(r);
+  } else {
+    r = model.noise();
+  }
+}
+
+// For a model of dynamic size that writes R in place: its noise(), from its noise_into() (CRTP:
+// class Model : public NoiseByWritingInPlace<Model>).
+template <class Model>
+struct NoiseByWritingInPlace {
+  Eigen::MatrixXd noise() const {
+    const Model& model = static_cast<const Model&>(*this);
+    Eigen::MatrixXd r = Eigen::MatrixXd::Zero(model.size(), model.size());
+    model.noise_into(r);
+    return r;
   }
 };
 

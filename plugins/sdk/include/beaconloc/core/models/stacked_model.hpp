@@ -14,7 +14,7 @@
 namespace beaconloc {
 
 template <class Part>
-class ModelList : public PredictsByWritingInPlace<ModelList<Part>> {
+class ModelList : public PredictsByWritingInPlace<ModelList<Part>>, public NoiseByWritingInPlace<ModelList<Part>> {
  public:
   static constexpr int kSize = Eigen::Dynamic;
   static constexpr bool kHasJacobian = Part::kHasJacobian;
@@ -54,18 +54,16 @@ class ModelList : public PredictsByWritingInPlace<ModelList<Part>> {
     }
     return out;
   }
-  Eigen::MatrixXd noise() const {
-    Eigen::MatrixXd r = Eigen::MatrixXd::Zero(size_, size_);
+  void noise_into(Eigen::Ref<Eigen::MatrixXd> r) const {
     Eigen::Index at = 0;
     for (const Part& p : parts_) {
-      if constexpr (Part::kSize == Eigen::Dynamic) {
-        r.block(at, at, p.size(), p.size()) = p.noise();
+      if constexpr (Part::kSize != Eigen::Dynamic && !WritesNoiseInPlace<Part>::value) {
+        r.template block<Part::kSize, Part::kSize>(at, at) = p.noise();  // a fixed-size block
       } else {
-        r.template block<Part::kSize, Part::kSize>(at, at) = p.noise();
+        beaconloc::noise_into(p, r.block(at, at, p.size(), p.size()));
       }
       at += p.size();
     }
-    return r;
   }
   Vector residual(const Vector& z, const Vector& h) const {
     Vector out(size_);
@@ -85,7 +83,8 @@ class ModelList : public PredictsByWritingInPlace<ModelList<Part>> {
 };
 
 template <class A, class B>
-class StackedModel : public PredictsByWritingInPlace<StackedModel<A, B>> {
+class StackedModel : public PredictsByWritingInPlace<StackedModel<A, B>>,
+                     public NoiseByWritingInPlace<StackedModel<A, B>> {
  public:
   static constexpr int kSize = Eigen::Dynamic;
   static constexpr bool kHasJacobian = A::kHasJacobian && B::kHasJacobian;
@@ -114,12 +113,9 @@ class StackedModel : public PredictsByWritingInPlace<StackedModel<A, B>> {
     out.jacobian.bottomRows(k) = b.jacobian;
     return out;
   }
-  Eigen::MatrixXd noise() const {
-    const Eigen::Index m = first_.size();
-    Eigen::MatrixXd r = Eigen::MatrixXd::Zero(size(), size());
-    r.topLeftCorner(m, m) = first_.noise();
-    r.bottomRightCorner(second_.size(), second_.size()) = second_.noise();
-    return r;
+  void noise_into(Eigen::Ref<Eigen::MatrixXd> r) const {
+    beaconloc::noise_into(first_, r.topLeftCorner(first_.size(), first_.size()));
+    beaconloc::noise_into(second_, r.bottomRightCorner(second_.size(), second_.size()));
   }
   Vector residual(const Vector& z, const Vector& h) const {
     const Eigen::Index m = first_.size(), k = second_.size();
