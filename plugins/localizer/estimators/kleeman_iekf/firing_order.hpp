@@ -13,10 +13,12 @@
 
 namespace beaconloc::kleeman {
 
-// The most slots a pulse may lie ahead of the filter's current slot: two cycles of the six
-// beacons. A pulse further ahead means the filter's t0 or T is far off (or the pulse's stamp is),
-// and stepping the filter through that many slots would only spread its uncertainty.
-inline constexpr std::int64_t kMaxSlotsAhead = 12;
+// The most slots a pulse may lie ahead of the filter's current slot: 10 s of seed 002's 150 ms
+// slots, after which a pose without a correction is lost anyway (StalenessPolicy). Through a
+// shorter silence (an outage, a robot behind a pillar) the filter steps slot by slot on its dead
+// reckoning, its uncertainty growing as it should; a pulse further ahead means the filter's t0
+// or T is far off (or the pulse's stamp is), and the estimator starts again.
+inline constexpr std::int64_t kMaxSlotsAhead = 67;
 
 // Where a pulse heard at arrival_s falls against the slots t0_s + k period_s (k >= 0).
 struct PulseSlot {

@@ -42,6 +42,13 @@ enum class Rejection : std::uint8_t {
   kStaleScan,
   kLaserUnused,
   kRawTofUnused,  // a raw time of flight, to an estimator of decoded ranges
+  // Pulse arrivals without a firing time (seed 002).
+  kPulseUnused,             // to an estimator that does not track the beacons' cycle
+  kPulseBeforeDoubleBurst,  // heard before the first double burst: no beacon can be named yet
+  kPulseBetweenSlots,       // later than the longest flight after any firing: not a direct pulse
+  kPulseLate,               // of a slot the filter has moved past
+  kPulseTooFarAhead,        // further ahead of the filter's cycle than it can step (kMaxSlotsAhead)
+  kStartupFitFailed,        // the start-up fit found no state that explains its arrival times
   // Out-of-sequence fusion (core/out_of_sequence_fusion.hpp).
   kTooLate,
   kAheadOfOdometry,
