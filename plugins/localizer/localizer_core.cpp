@@ -106,8 +106,9 @@ std::optional<LocalizerOutput> LocalizerCore::output(const std::string& robot_id
   estimate->status = r.status();
   LocalizerOutput out{robot_id, *estimate, {r.beacons_used.begin(), r.beacons_used.end()}, {}};
   r.beacons_used.clear();
-  if (!r.state_sent_ns || estimate->stamp_ns >= *r.state_sent_ns + kEstimatorStatePeriodNs ||
-      estimate->stamp_ns < *r.state_sent_ns) {
+  // Compared as a difference: a stamp near the clock's end must not overflow.
+  if (!r.state_sent_ns || estimate->stamp_ns < *r.state_sent_ns ||
+      estimate->stamp_ns - *r.state_sent_ns >= kEstimatorStatePeriodNs) {
     out.state = r.fusion.estimator().state_values();
     // Like a pose, never a non-finite number out: an estimator whose state is not finite has a
     // pose no better (and publishable() would have caught most); the state is dropped, counted.
@@ -181,8 +182,9 @@ std::optional<LocalizerOutput> LocalizerCore::on_measurement(const std::string& 
   Robot* r = robot(robot_id, kind.c_str());
   if (!r) return std::nullopt;
   const std::optional<std::uint32_t> beacon = beacon_of(input);
-  // The bus delivers beacon measurements again; whether they fit is the estimator's call.
-  if (beacon) r->ranges_silent = false;
+  // The bus delivers beacon measurements again (of any kind, pulses too); whether they fit is the
+  // estimator's call.
+  if (is_beacon_input(input, beacon_input_)) r->ranges_silent = false;
   const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
   const InputResult result = r->fusion.push(std::move(input));
   if (!result.accepted) {

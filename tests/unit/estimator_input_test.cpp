@@ -204,5 +204,34 @@ TEST(EstimatorInput, TheEstimatorStateGoesOutOnceASecondWithAPose) {
   }
 }
 
+// A robot whose pulses missed their deadline is degraded; the next pulse makes it ok again, as a
+// range does for the estimators of ranges.
+TEST(EstimatorInput, APulseAfterAMissedDeadlineEndsTheSilence) {
+  const sim::Scenario s = sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/seed002_kleeman.yaml");
+  sim::Scenario moving = s;
+  moving.trajectory = sim::Trajectory(Pose2(1.5, 1.5, 0.0), {{30.0, 0.25, 0.0}}, false);
+  EstimatorConfig config;
+  config.receivers = s.receivers;
+  LocalizerCore core("kleeman_iekf", config);
+  core.set_beacon_map(BeaconMap(s.beacons));
+  bool silenced = false;
+  std::optional<PoseStatus> after;
+  for (const SourceEvent& e : simulate(moving, 1, 12.0)) {
+    if (e.kind == SourceEvent::Kind::kOdometry) {
+      if (auto out = core.on_odometry("r", e.odometry); out && silenced) after = out->estimate.status;
+    }
+    if (e.kind != SourceEvent::Kind::kPulse) continue;
+    if (!silenced && ns_to_s(e.stamp_ns) > 8.0) {
+      core.on_ranges_silent("r");
+      ASSERT_EQ(core.worst_status(), PoseStatus::kDegraded);
+      silenced = true;
+      continue;
+    }
+    core.on_pulse("r", e.pulse);
+  }
+  ASSERT_TRUE(after);
+  EXPECT_EQ(*after, PoseStatus::kOk);
+}
+
 }  // namespace
 }  // namespace beaconloc

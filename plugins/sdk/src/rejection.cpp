@@ -36,6 +36,9 @@ const char* to_string(Rejection r) {
     case Rejection::kPulseLate: return "pulse_late";
     case Rejection::kPulseTooFarAhead: return "pulse_too_far_ahead";
     case Rejection::kStartupFitFailed: return "startup_fit_failed";
+    case Rejection::kDuplicatePulse: return "duplicate_pulse";
+    case Rejection::kTooManyPulsesInSlot: return "too_many_pulses_in_slot";
+    case Rejection::kBeaconMapUnusable: return "beacon_map_unusable";
     case Rejection::kTooLate: return "too_late";
     case Rejection::kAheadOfOdometry: return "ahead_of_odometry";
     case Rejection::kGatedNis: return "gated_nis";

@@ -101,9 +101,12 @@ KleemanIekf::KleemanIekf(const EstimatorConfig& config, const KleemanParameters&
   if (receivers_.receivers_base_m.empty()) throw std::invalid_argument("kleeman_iekf: the robot has no receiver");
 }
 
+// Sec. 2: the beacons fire in the order of their numbers (123456123...), one a slot of the
+// slot_period_s parameter (the beacon controller's configuration, as the paper's receiver knows
+// it). What was tracked against another map starts again.
 void KleemanIekf::set_beacon_map(const BeaconMap& map) {
   EstimatorBase::set_beacon_map(map);
-  // Sec. 2: the beacons fire in the order of their numbers (123456123...).
+  reset_tracking();
   order_.clear();
   Eigen::AlignedBox3d extent;
   for (const Beacon& b : map.beacons()) {
@@ -111,15 +114,36 @@ void KleemanIekf::set_beacon_map(const BeaconMap& map) {
     extent.extend(b.position_map_m);
   }
   std::sort(order_.begin(), order_.end());
-  const auto marked = static_cast<std::uint32_t>(params_.marked_beacon_id);
   firing_.reset();
-  if (std::find(order_.begin(), order_.end(), marked) != order_.end()) firing_.emplace(order_, marked);
-  // The longest flight: across the beacons' extent, down to the receiver, at the slowest sound.
+  map_problem_.reset();
+  // The longest flight: across the beacons' extent (the robot inside it), down to the receiver,
+  // at the slowest sound, and an echo's delay. Past half a slot a pulse could belong to two.
   const Eigen::Vector3d span(extent.sizes().x(), extent.sizes().y(),
                              std::max(std::abs(extent.max().z() - receivers_.receiver_height_m),
                                       std::abs(extent.min().z() - receivers_.receiver_height_m)));
-  max_flight_s_ = std::min(map.beacons().empty() ? 0.0 : span.norm() / kSlowestSoundMps + kEchoAllowanceS,
-                           0.9 * params_.slot_period_s);
+  max_flight_s_ = map.empty() ? 0.0 : span.norm() / kSlowestSoundMps + kEchoAllowanceS;
+  const auto marked = static_cast<std::uint32_t>(params_.marked_beacon_id);
+  if (std::find(order_.begin(), order_.end(), marked) == order_.end()) {
+    map_problem_ = "the marked beacon " + std::to_string(marked) + " is not in the beacon map";
+  } else if (order_.size() < 3) {
+    map_problem_ = std::to_string(order_.size()) + " beacon(s): a position and a firing time need three";
+  } else if (max_flight_s_ >= 0.5 * params_.slot_period_s) {
+    map_problem_ = "the beacons span " + std::to_string(span.norm()) + " m: a flight of up to " +
+                   std::to_string(1e3 * max_flight_s_) + " ms is over half a slot, the slots would be ambiguous";
+  } else {
+    firing_.emplace(order_, marked);
+  }
+}
+
+void KleemanIekf::reset_tracking() {
+  filter_.reset();
+  travel_.clear();
+  if (has_pose()) forget_pose();
+  window_.clear();
+  sync_arrival_s_.reset();
+  recent_pulses_.clear();
+  counted_slot_ = -1;
+  pulses_in_slot_ = 0;
 }
 
 const Beacon* KleemanIekf::beacon(std::uint32_t id) const { return map().find(id); }
@@ -129,6 +153,17 @@ InputResult KleemanIekf::predict(const OdometrySample& o) {
   if (!step.result.accepted) return step.result;
   if (!epoch_ns_) epoch_ns_ = o.stamp_ns;
   if (step.integrate) track_.add(o, seconds(o.stamp_ns), step.dt_s);
+  // A silence: no pulse for as long as the filter may step (kMaxSlotsAhead slots), or a start-up
+  // window gone stale. What was held is dropped, so that nothing grows while the beacons are quiet.
+  const double now_s = seconds(o.stamp_ns);
+  if (filter_ && now_s - filter_->state()(idx::kFireTime) > kleeman::kMaxSlotsAhead * filter_->state()(idx::kCycle)) {
+    ++silences_;
+    lose();
+  } else if (sync_arrival_s_ &&
+             now_s - *sync_arrival_s_ > static_cast<double>(startup_slots_needed() + 2 * order_.size()) * params_.slot_period_s) {
+    sync_arrival_s_.reset();
+    window_.clear();
+  }
   // Kept: the odometry since the oldest pulse of the window, and since the filter's slot.
   double keep_from = seconds(o.stamp_ns) - 1.0;
   if (!window_.empty()) keep_from = std::min(keep_from, window_.front().arrival_s - 1.0);
@@ -148,12 +183,34 @@ InputResult KleemanIekf::update_pulse(const PulseArrivalSample& p) {
   if (p.stamp_ns < 0) return InputResult::rejected(Rejection::kInvalidStamp);
   if (p.receiver_id >= receivers_.size()) return InputResult::rejected(Rejection::kUnknownReceiver);
   if (map().empty()) return InputResult::rejected(Rejection::kNoBeaconMap);
-  if (!firing_) return InputResult::rejected(Rejection::kUnknownBeacon);  // the marked beacon is not in the map
+  if (!firing_) return InputResult::rejected(Rejection::kBeaconMapUnusable);  // map_problem_ says why
   // The odometry stamps the pose and carries it between slots (and epoch_ns_ is set with it).
   if (!now_ns() || !epoch_ns_) return InputResult::rejected(Rejection::kRangesWithoutOdometry);
   if (p.stamp_ns < *now_ns() - kMeasurementHorizonNs) return InputResult::rejected(Rejection::kStaleRange);
+  if (heard_before(p)) return InputResult::rejected(Rejection::kDuplicatePulse);
   const double arrival_s = seconds(p.stamp_ns);
   return filter_ ? track(p, arrival_s) : collect_startup(p, arrival_s);
+}
+
+bool KleemanIekf::heard_before(const PulseArrivalSample& p) {
+  constexpr std::size_t kRemembered = 64;  // several cycles of every receiver's pulses
+  const std::pair<std::uint32_t, StampNs> key{p.receiver_id, p.stamp_ns};
+  if (std::find(recent_pulses_.begin(), recent_pulses_.end(), key) != recent_pulses_.end()) return true;
+  recent_pulses_.push_back(key);
+  if (recent_pulses_.size() > kRemembered) recent_pulses_.pop_front();
+  return false;
+}
+
+InputResult KleemanIekf::count_in_slot(std::int64_t slot) {
+  if (slot != counted_slot_) {
+    counted_slot_ = slot;
+    pulses_in_slot_ = 0;
+  }
+  if (pulses_in_slot_ >= kMaxPulsesPerSlotPerReceiver * static_cast<int>(receivers_.size())) {
+    return InputResult::rejected(Rejection::kTooManyPulsesInSlot);
+  }
+  ++pulses_in_slot_;
+  return InputResult::ok();
 }
 
 kleeman::StartupFitSettings KleemanIekf::fit_settings() const {
@@ -165,166 +222,12 @@ kleeman::StartupFitSettings KleemanIekf::fit_settings() const {
   s.speed_of_sound_sigma_mps = params_.initial_speed_of_sound_sigma_mps;
   s.cycle_s = params_.slot_period_s;
   s.cycle_sigma_s = params_.slot_period_sigma_s;
-  s.min_beacons = std::min<int>(4, static_cast<int>(order_.size()));
+  s.min_beacons = 3;  // set_beacon_map refuses fewer
   return s;
 }
 
-// Start-up (issue 15 item 5): the pulses after the first double burst, numbered by their slot
-// from it with the nominal T (a flight shorter than half a slot leaves each in its own), until
-// startup_cycles cycles are in; then the fit.
-InputResult KleemanIekf::collect_startup(const PulseArrivalSample& p, double arrival_s) {
-  const bool double_burst = p.mark == PulseMark::kDouble;
-  if (!sync_arrival_s_) {
-    if (!double_burst) return InputResult::rejected(Rejection::kPulseBeforeDoubleBurst);
-    sync_arrival_s_ = arrival_s;
-    window_.clear();
-  }
-  const double slots = (arrival_s - *sync_arrival_s_) / params_.slot_period_s;
-  const auto n = static_cast<std::int64_t>(order_.size());
-  if (!(slots >= -0.5) || slots > static_cast<double>((params_.startup_cycles + 1) * n)) {
-    // Before the sync (out of order) or far past the window (a long silence): start again.
-    sync_arrival_s_.reset();
-    window_.clear();
-    return double_burst ? collect_startup(p, arrival_s) : InputResult::rejected(Rejection::kPulseBeforeDoubleBurst);
-  }
-  const std::int64_t slot = std::llround(slots);
-  if (std::abs(slots - static_cast<double>(slot)) * params_.slot_period_s > max_flight_s_) {
-    return InputResult::rejected(Rejection::kPulseBetweenSlots);
-  }
-  if (!window_.empty() && slot < window_.back().slot) return InputResult::rejected(Rejection::kPulseLate);
-  const std::uint32_t marked = static_cast<std::uint32_t>(params_.marked_beacon_id);
-  const std::size_t marked_index = static_cast<std::size_t>(std::find(order_.begin(), order_.end(), marked) - order_.begin());
-  const std::uint32_t id = order_[(marked_index + static_cast<std::size_t>(slot % n)) % order_.size()];
-  if (double_burst && id != marked) {
-    // A double burst where the numbering has another beacon: the numbering was wrong; restart from it.
-    sync_arrival_s_.reset();
-    window_.clear();
-    return collect_startup(p, arrival_s);
-  }
-  window_.push_back({slot, arrival_s, id, beacon(id)->position_map_m});
-  if (slot < params_.startup_cycles * n) return InputResult::ok();
-
-  const kleeman::StartupFit fit =
-      fit_startup({window_.begin(), window_.end()}, params_.dead_reckoning ? &track_ : nullptr, fit_settings());
-  if (!fit.ok) {
-    ++startup_fits_failed_;
-    last_fit_failure_ = StartupWait{StartupCondition::kFixFailed, 0.0, 0.0, fit.why_not};
-    sync_arrival_s_.reset();  // again from the next double burst
-    window_.clear();
-    return InputResult::ok();  // the pulse was heard; the fit's failure is the start-up's state
-  }
-  start_from_fit(fit, p.stamp_ns);
-  return InputResult::ok();
-}
-
-KleemanIekf::FittedPose KleemanIekf::pose_from_fit(const kleeman::StartupFit& fit, double at_s) const {
-  using P = kleeman::StartupFit::Parameter;
-  const auto at = [](P q) { return static_cast<Eigen::Index>(q); };
-  kleeman::DeadReckoning d;
-  if (params_.dead_reckoning) {
-    d = at_s >= fit.reference_s ? track_.between(fit.reference_s, at_s) : kleeman::DeadReckoning{};
-  }
-  const double heading = fit.solution(at(P::kHeading));
-  const double c = std::cos(heading), s = std::sin(heading);
-  FittedPose out;
-  out.pose = Pose2(fit.solution(at(P::kX)) + c * d.forward_m - s * d.left_m,
-                   fit.solution(at(P::kY)) + s * d.forward_m + c * d.left_m, wrap_angle_rad(heading + d.dtheta_rad));
-  Eigen::Matrix3d j = Eigen::Matrix3d::Identity();  // d(pose at at_s)/d(x, y, theta at the reference)
-  j(0, 2) = -s * d.forward_m - c * d.left_m;
-  j(1, 2) = c * d.forward_m - s * d.left_m;
-  Eigen::Matrix3d c3;
-  const Eigen::Index pose_at[3] = {at(P::kX), at(P::kY), at(P::kHeading)};
-  for (int r = 0; r < 3; ++r)
-    for (int q = 0; q < 3; ++q) c3(r, q) = fit.covariance(pose_at[r], pose_at[q]);
-  out.covariance = j * c3 * j.transpose();
-  out.covariance += Eigen::Vector3d(d.distance_variance, d.distance_variance, d.dtheta_variance).asDiagonal();
-  // An unobserved heading (the robot stood still) is uniform: at most a half turn's variance.
-  if (!fit.heading_observed || out.covariance(2, 2) > M_PI * M_PI) {
-    out.covariance.row(2).setZero();
-    out.covariance.col(2).setZero();
-    out.covariance(2, 2) = M_PI * M_PI;
-  }
-  return out;
-}
-
-void KleemanIekf::start_from_fit(const kleeman::StartupFit& fit, StampNs stamp_ns) {
-  using P = kleeman::StartupFit::Parameter;
-  const auto at = [](P q) { return static_cast<Eigen::Index>(q); };
-  const std::int64_t slot = window_.back().slot;
-  const double slots = static_cast<double>(slot - fit.first_slot);
-  const double period = fit.solution(at(P::kCycle));
-  const double fire_s = fit.solution(at(P::kFirstFireTime)) + slots * period;
-  const FittedPose pose = pose_from_fit(fit, fire_s);
-  State x;
-  x(idx::kX) = pose.pose.x();
-  x(idx::kY) = pose.pose.y();
-  x(idx::kHeading) = pose.pose.z();
-  x(idx::kCycle) = period;
-  x(idx::kFireTime) = fire_s;
-  x(idx::kSpeedOfSound) = fit.solution(at(P::kSpeedOfSound));
-  double speed_variance = 1.0;  // without dead reckoning: a speed within a few m/s
-  x(idx::kSpeed) = 0.0;
-  if (params_.dead_reckoning) {
-    const kleeman::DeadReckoning d = track_.between(fire_s - period, fire_s);
-    x(idx::kSpeed) = d.distance_m / period;
-    speed_variance = d.distance_variance / (period * period) + params_.speed_sigma_mps * params_.speed_sigma_mps;
-  }
-  heading_known_ = pose.covariance(2, 2) <= params_.max_ok_heading_sigma_rad * params_.max_ok_heading_sigma_rad;
-  if (!heading_known_) {  // carried at v = 0 until the heading is found (heading_known_)
-    x(idx::kSpeed) = 0.0;
-    speed_variance = 1e-12;
-  }
-  Covariance p = Covariance::Zero();
-  const Eigen::Index pose_at[3] = {idx::kX, idx::kY, idx::kHeading};
-  for (int r = 0; r < 3; ++r)
-    for (int q = 0; q < 3; ++q) p(pose_at[r], pose_at[q]) = pose.covariance(r, q);
-  // t0 of the current slot = t_first + slots T; T and s as fitted, with their correlations.
-  Eigen::Matrix3d g = Eigen::Matrix3d::Zero();  // (T, t0, s) from (t_first, T, s)
-  g(0, 1) = 1.0;
-  g(1, 0) = 1.0;
-  g(1, 1) = slots;
-  g(2, 2) = 1.0;
-  Eigen::Matrix3d c3;
-  const Eigen::Index fit_at[3] = {at(P::kFirstFireTime), at(P::kCycle), at(P::kSpeedOfSound)};
-  for (int r = 0; r < 3; ++r)
-    for (int q = 0; q < 3; ++q) c3(r, q) = fit.covariance(fit_at[r], fit_at[q]);
-  const Eigen::Matrix3d timing = g * c3 * g.transpose();
-  const Eigen::Index timing_at[3] = {idx::kCycle, idx::kFireTime, idx::kSpeedOfSound};
-  for (int r = 0; r < 3; ++r)
-    for (int q = 0; q < 3; ++q) p(timing_at[r], timing_at[q]) = timing(r, q);
-  p(idx::kSpeed, idx::kSpeed) = speed_variance;
-  filter_.emplace(kleeman::state_space(), IteratedEkfOptions{params_.max_iterations, 1e-9});
-  if (filter_->reset(x, p) != FilterOutcome::kApplied) {
-    filter_.reset();
-    ++startup_fits_failed_;
-    last_fit_failure_ = StartupWait{StartupCondition::kFixFailed, 0.0, 0.0, "the fit's covariance is not positive definite"};
-    sync_arrival_s_.reset();
-    window_.clear();
-    return;
-  }
-  // The firing order, numbered as the window was; the filter's slot is the window's last.
-  firing_.emplace(order_, static_cast<std::uint32_t>(params_.marked_beacon_id));
-  bool first = true;  // the window starts at the first double burst
-  for (const kleeman::SlotPulse& w : window_) {
-    firing_->heard(w.slot, first);
-    first = false;
-  }
-  slot_index_ = slot;
-  slots_since_start_ = 0;
-  travel_.clear();
-  consecutive_gated_ = 0;
-  consecutive_far_ = 0;
-  sync_arrival_s_.reset();
-  last_fit_failure_.reset();
-  start(std::max(stamp_ns, now_ns().value_or(stamp_ns)));
-}
-
 void KleemanIekf::lose() {
-  filter_.reset();
-  travel_.clear();
-  forget_pose();
-  window_.clear();
-  sync_arrival_s_.reset();
+  reset_tracking();
   ++losses_;
 }
 
@@ -332,21 +235,21 @@ FilterOutcome KleemanIekf::advance_slots(std::int64_t slots) {
   for (std::int64_t i = 0; i < slots; ++i) {
     const State& x = filter_->state();
     const double period = x(idx::kCycle), from = x(idx::kFireTime);
-    double dtheta = 0.0, dtheta_variance = 0.0, unknown_travel_variance = 0.0;
+    double dtheta = 0.0, dtheta_variance_rad2 = 0.0, unknown_travel_variance = 0.0;
     kleeman::SlotNoise noise = params_.noise;
     if (params_.dead_reckoning && !heading_known_) {
       // The heading unknown: no move along it (v = 0), the travel as noise; the turn as eq. 24.
       const kleeman::DeadReckoning d = track_.between(from, from + period);
-      unknown_travel_variance = d.distance_m * d.distance_m + d.distance_variance;
+      unknown_travel_variance = d.distance_m * d.distance_m + d.distance_variance_m2;
       noise.speed_mps = 0.0;  // v stays 0: no pulse may find a speed along an unknown heading
       dtheta = d.dtheta_rad;
       const double model_sigma = params_.heading_offset_sigma_rad + params_.heading_fraction * std::abs(dtheta);
-      dtheta_variance = d.dtheta_variance + model_sigma * model_sigma;
+      dtheta_variance_rad2 = d.dtheta_variance_rad2 + model_sigma * model_sigma;
     } else if (params_.dead_reckoning) {
       // Eq. 25: the slot's mean dead-reckoned speed measures v, the speed over the slot.
       const kleeman::DeadReckoning d = track_.between(from, from + period);
       const double variance =
-          d.distance_variance / (period * period) + params_.speed_sigma_mps * params_.speed_sigma_mps;
+          d.distance_variance_m2 / (period * period) + params_.speed_sigma_mps * params_.speed_sigma_mps;
       Mat<1, kleeman::kStateSize> h = Mat<1, kleeman::kStateSize>::Zero();
       h(0, idx::kSpeed) = 1.0;
       const UpdateResult speed =
@@ -356,7 +259,7 @@ FilterOutcome KleemanIekf::advance_slots(std::int64_t slots) {
       // fraction of the increment.
       dtheta = d.dtheta_rad;
       const double model_sigma = params_.heading_offset_sigma_rad + params_.heading_fraction * std::abs(dtheta);
-      dtheta_variance = d.dtheta_variance + model_sigma * model_sigma;
+      dtheta_variance_rad2 = d.dtheta_variance_rad2 + model_sigma * model_sigma;
     } else if (!heading_known_) {
       // No dead reckoning and no heading yet: a random walk of the robot's top speed, v = 0.
       const double step = params_.unknown_speed_mps * period;
@@ -364,51 +267,16 @@ FilterOutcome KleemanIekf::advance_slots(std::int64_t slots) {
       noise.speed_mps = 0.0;
     } else {
       const double turn = params_.turn_rate_sigma_radps * period;
-      dtheta_variance = turn * turn;
+      dtheta_variance_rad2 = turn * turn;
     }
     const PredictResult predicted =
-        filter_->predict(kleeman::SlotTransition(dtheta_variance, noise, unknown_travel_variance), Vec<1>(dtheta), period);
+        filter_->predict(kleeman::SlotTransition(dtheta_variance_rad2, noise, unknown_travel_variance), Vec<1>(dtheta), period);
     if (!predicted.applied()) return predicted.outcome;
     ++slot_index_;
     ++slots_since_start_;
     if (!params_.dead_reckoning && !heading_known_) heading_from_travel();
   }
   return FilterOutcome::kApplied;
-}
-
-// Without dead reckoning the heading is the direction the beacons see the robot travel: once the
-// filter's position moved heading_fit_min_travel_m over at most heading_fit_cycles cycles, the
-// heading is that of the displacement and the speed its length over the time, each with the
-// variance the two positions' give (lateral sigma over the distance).
-void KleemanIekf::heading_from_travel() {
-  const State& x = filter_->state();
-  const Covariance& p = filter_->covariance();
-  travel_.push_back({x(idx::kFireTime), x.head<2>(), 0.5 * (p(idx::kX, idx::kX) + p(idx::kY, idx::kY))});
-  const auto span = static_cast<std::size_t>(params_.heading_fit_cycles * order_.size());
-  while (travel_.size() > span + 1) travel_.pop_front();
-  const TravelPoint& from = travel_.front();
-  const TravelPoint& to = travel_.back();
-  const Eigen::Vector2d d = to.position_m - from.position_m;
-  const double distance = d.norm(), dt = to.t_s - from.t_s;
-  if (distance < params_.heading_fit_min_travel_m || !(dt > 0.0)) return;
-  const double variance = from.variance_m2 + to.variance_m2;
-  const double heading_variance = variance / (distance * distance);
-  if (heading_variance > 0.25 * params_.max_ok_heading_sigma_rad * params_.max_ok_heading_sigma_rad) return;
-  State next = x;
-  next(idx::kHeading) = std::atan2(d.y(), d.x());
-  next(idx::kSpeed) = distance / dt;
-  Covariance next_p = p;
-  for (const Eigen::Index i : {idx::kHeading, idx::kSpeed}) {
-    next_p.row(i).setZero();
-    next_p.col(i).setZero();
-  }
-  next_p(idx::kHeading, idx::kHeading) = heading_variance;
-  next_p(idx::kSpeed, idx::kSpeed) = variance / (dt * dt);
-  if (filter_->reset(next, next_p) == FilterOutcome::kApplied) {
-    heading_known_ = true;
-    ++heading_fits_;
-    travel_.clear();
-  }
 }
 
 void KleemanIekf::remember(const kleeman::SlotPulse& pulse) {
@@ -431,6 +299,9 @@ InputResult KleemanIekf::track(const PulseArrivalSample& p, double arrival_s) {
   if (slot->kind == kleeman::PulseSlot::Kind::kPast) return InputResult::rejected(Rejection::kPulseLate);
   if (slot->kind == kleeman::PulseSlot::Kind::kBetweenSlots) return InputResult::rejected(Rejection::kPulseBetweenSlots);
   const std::int64_t pulse_slot = slot_index_ + slot->slots_ahead;
+  if (!firing_->synchronized()) return InputResult::rejected(Rejection::kPulseBeforeDoubleBurst);
+  if (pulse_slot < counted_slot_) return InputResult::rejected(Rejection::kPulseLate);
+  if (const InputResult room = count_in_slot(pulse_slot); !room.accepted) return room;
   if (firing_->heard(pulse_slot, p.mark == PulseMark::kDouble) == kleeman::FiringOrder::Pulse::kOutOfOrder) {
     return InputResult::rejected(Rejection::kPulseLate);
   }
@@ -457,65 +328,6 @@ InputResult KleemanIekf::track(const PulseArrivalSample& p, double arrival_s) {
   }
 }
 
-// The heading is only observable by moving (eq. 15): while the filter's is unknown (the robot
-// stood still since start-up), the last cycles' pulses, once the robot moved, give it by the
-// start-up fit, and the filter's pose takes it.
-void KleemanIekf::refit_heading() {
-  const Covariance& p = filter_->covariance();
-  if (!params_.dead_reckoning || heading_known_) return;
-  const auto span = static_cast<std::int64_t>(params_.heading_fit_cycles * order_.size());
-  if (window_.back().slot - window_.front().slot + 1 < span) return;
-  const State& x = filter_->state();
-  kleeman::StartupFitSettings settings = fit_settings();
-  settings.heading_observed_after_m = params_.heading_fit_min_travel_m;
-  settings.speed_of_sound_mps = x(idx::kSpeedOfSound);
-  settings.speed_of_sound_sigma_mps = std::sqrt(p(idx::kSpeedOfSound, idx::kSpeedOfSound));
-  settings.cycle_s = x(idx::kCycle);
-  settings.cycle_sigma_s = std::sqrt(p(idx::kCycle, idx::kCycle));
-  const auto first = std::find_if(window_.begin(), window_.end(), [&](const kleeman::SlotPulse& w) {
-    return w.slot > window_.back().slot - span;
-  });
-  // Not before the robot travelled far enough in the window (the fit would find no heading).
-  const kleeman::DeadReckoning travelled = track_.between(first->arrival_s, window_.back().arrival_s);
-  if (std::hypot(travelled.forward_m, travelled.left_m) < params_.heading_fit_min_travel_m) return;
-  const kleeman::StartupFit fit = fit_startup({first, window_.end()}, &track_, settings, x(idx::kHeading));
-  if (!fit.ok || !fit.heading_observed) return;
-  const FittedPose pose = pose_from_fit(fit, x(idx::kFireTime));
-  const double ok_variance = params_.max_ok_heading_sigma_rad * params_.max_ok_heading_sigma_rad;
-  if (!(pose.covariance(2, 2) < 0.25 * ok_variance)) return;
-  State next = x;
-  next(idx::kX) = pose.pose.x();
-  next(idx::kY) = pose.pose.y();
-  next(idx::kHeading) = pose.pose.z();
-  Covariance next_p = p;
-  const Eigen::Index pose_at[3] = {idx::kX, idx::kY, idx::kHeading};
-  for (const Eigen::Index r : pose_at) {
-    next_p.row(r).setZero();
-    next_p.col(r).setZero();
-  }
-  for (int r = 0; r < 3; ++r)
-    for (int q = 0; q < 3; ++q) next_p(pose_at[r], pose_at[q]) = pose.covariance(r, q);
-  if (filter_->reset(next, next_p) == FilterOutcome::kApplied) {
-    ++heading_fits_;
-    know_heading();
-  }
-}
-
-void KleemanIekf::know_heading() {
-  if (heading_known_) return;
-  heading_known_ = true;
-  State x = filter_->state();
-  Covariance p = filter_->covariance();
-  const double period = x(idx::kCycle);
-  const kleeman::DeadReckoning d = track_.between(x(idx::kFireTime) - period, x(idx::kFireTime));
-  x(idx::kSpeed) = d.distance_m / period;
-  p.row(idx::kSpeed).setZero();
-  p.col(idx::kSpeed).setZero();
-  p(idx::kSpeed, idx::kSpeed) =
-      d.distance_variance / (period * period) + params_.speed_sigma_mps * params_.speed_sigma_mps;
-  filter_->reset(x, p);
-}
-
 EstimatorBase::PoseBelief KleemanIekf::pose_belief() const {
   const State& x = filter_->state();
   const Covariance& p = filter_->covariance();
@@ -530,7 +342,7 @@ EstimatorBase::PoseBelief KleemanIekf::pose_belief() const {
     forward = d.forward_m;
     left = d.left_m;
     dtheta = d.dtheta_rad;
-    motion_variance << d.distance_variance, d.distance_variance, d.dtheta_variance;
+    motion_variance << d.distance_variance_m2, d.distance_variance_m2, d.dtheta_variance_rad2;
   } else {
     forward = x(idx::kSpeed) * tau;  // eq. 15 over the part of a slot
     j(0, idx::kSpeed) = c * tau;
@@ -553,13 +365,10 @@ EstimatorBase::PoseBelief KleemanIekf::pose_belief() const {
 }
 
 StartupWait KleemanIekf::waiting_for() const {
-  if (!firing_) {
-    return {StartupCondition::kFixFailed, 0.0, 0.0,
-            "the marked beacon " + std::to_string(params_.marked_beacon_id) + " is not in the beacon map"};
-  }
+  if (!firing_) return {StartupCondition::kFixFailed, 0.0, 0.0, map_problem_.value_or("no beacon map")};
   if (last_fit_failure_ && !sync_arrival_s_) return *last_fit_failure_;
   if (!sync_arrival_s_) return {StartupCondition::kNoDoubleBurst, 0.0, 1.0, {}};
-  const double needed = static_cast<double>(params_.startup_cycles * order_.size() + 1);
+  const double needed = static_cast<double>(startup_slots_needed() + 1);
   const double heard = window_.empty() ? 0.0 : static_cast<double>(window_.back().slot + 1);
   return {StartupCondition::kTooFewRanges, heard, needed, "slots of pulse arrivals for the start-up fit"};
 }
@@ -567,8 +376,7 @@ StartupWait KleemanIekf::waiting_for() const {
 bool KleemanIekf::suspect() const {
   if (!filter_) return false;
   const double heading_variance = filter_->covariance()(idx::kHeading, idx::kHeading);
-  return consecutive_gated_ >= 3 ||
-         heading_variance > params_.max_ok_heading_sigma_rad * params_.max_ok_heading_sigma_rad;
+  return consecutive_gated_ >= 3 || heading_variance > heading_ok_variance();
 }
 
 std::vector<Estimator::StateValue> KleemanIekf::state_values() const {
@@ -576,7 +384,10 @@ std::vector<Estimator::StateValue> KleemanIekf::state_values() const {
   const State& x = filter_->state();
   const Covariance& p = filter_->covariance();
   const auto value = [&](const char* name, Eigen::Index i) { return StateValue{name, x(i), std::sqrt(p(i, i))}; };
-  return {value("speed_of_sound_mps", idx::kSpeedOfSound), value("cycle_s", idx::kCycle), value("speed_mps", idx::kSpeed)};
+  std::vector<StateValue> out{value("speed_of_sound_mps", idx::kSpeedOfSound), value("cycle_s", idx::kCycle)};
+  // While the heading is unknown v is held at 0 (heading_known_): not an estimate of the speed.
+  if (heading_known_) out.push_back(value("speed_mps", idx::kSpeed));
+  return out;
 }
 
 std::optional<kleeman::State> KleemanIekf::filter_state() const {

@@ -15,8 +15,12 @@
 //  - Start-up from the arrival times themselves (startup_fit.hpp) instead of the paper's 15 s
 //    standing still: a few cycles after the first double burst; a robot that stood still has its
 //    heading found the same way once it has moved (the heading is only observable by moving).
-//  - Lost (the cycle's numbering no longer fits: pulses gated or far off for two cycles): back
-//    to start-up.
+//  - Lost, back to start-up: when the cycle's numbering no longer fits (lost_after_gated pulses
+//    gated in a row, or three pulses in a row further ahead than the filter can step), and when
+//    no pulse came for as long as it can step (a silence).
+//  - Refused by reason: a duplicate pulse (a receiver's arrival stamp heard already), more than
+//    kMaxPulsesPerSlotPerReceiver in a slot (a flood), a map it cannot number (no marked beacon,
+//    fewer than three beacons, or flights over half a slot: the slots would be ambiguous).
 #include <deque>
 #include <optional>
 
@@ -87,9 +91,16 @@ class KleemanIekf final : public EstimatorBase {
   std::optional<kleeman::Covariance> filter_covariance() const;
   std::optional<StampNs> epoch_ns() const { return epoch_ns_; }
   const kleeman::FiringOrder* firing_order() const { return firing_ ? &*firing_ : nullptr; }
+  // The beacon that fired in the filter's current slot (t0), as it numbers them; nullopt before.
+  std::optional<std::uint32_t> current_beacon() const {
+    return filter_ && firing_ ? firing_->beacon_of(slot_index_) : std::nullopt;
+  }
   std::uint64_t startup_fits_failed() const { return startup_fits_failed_; }
+  // Pulses one receiver may give in one slot: the direct one and a few echoes. More is a flood.
+  static constexpr int kMaxPulsesPerSlotPerReceiver = 4;
   std::uint64_t heading_fits() const { return heading_fits_; }
   std::uint64_t losses() const { return losses_; }
+  std::uint64_t silences() const { return silences_; }  // losses for want of pulses
 
  private:
   PoseBelief pose_belief() const override;
@@ -102,13 +113,16 @@ class KleemanIekf final : public EstimatorBase {
   FilterOutcome advance_slots(std::int64_t slots);
   void remember(const kleeman::SlotPulse& pulse);
   kleeman::StartupFitSettings fit_settings() const;
-  // The fit's pose moved by the dead reckoning to at_s, and its covariance.
-  struct FittedPose {
-    Pose2 pose;
-    Cov3 covariance;
-  };
-  FittedPose pose_from_fit(const kleeman::StartupFit& fit, double at_s) const;
-  void start_from_fit(const kleeman::StartupFit& fit, StampNs stamp_ns);
+  std::int64_t startup_slots_needed() const;
+  // False (and the filter not started, the failure counted) when the fit's state is not finite.
+  bool start_from_fit(const kleeman::StartupFit& fit, StampNs stamp_ns);
+  // Counts a pulse in `slot`; too_many_pulses_in_slot past the cap.
+  InputResult count_in_slot(std::int64_t slot);
+  // A duplicate of a pulse heard lately (same receiver, same arrival stamp).
+  bool heard_before(const PulseArrivalSample& pulse);
+  // Back to start-up (a map change, or what lose() says).
+  void reset_tracking();
+  double heading_ok_variance() const { return params_.max_ok_heading_sigma_rad * params_.max_ok_heading_sigma_rad; }
   void refit_heading();
   // Leaves the mode of an unknown heading (heading_known_) with the speed of the dead reckoning.
   void know_heading();
@@ -120,6 +134,7 @@ class KleemanIekf final : public EstimatorBase {
   ReceiverArray receivers_;
   double nis_gate_ = 0.0;
   double max_flight_s_ = 0.0;  // the longest direct flight across the beacons' extent, and echoes
+  std::optional<std::string> map_problem_;  // why the map cannot be numbered (pulses refused)
   std::optional<StampNs> epoch_ns_;
   kleeman::OdometryTrack track_;
   std::optional<kleeman::FiringOrder> firing_;
@@ -143,11 +158,15 @@ class KleemanIekf final : public EstimatorBase {
   };
   std::deque<TravelPoint> travel_;
   int consecutive_gated_ = 0;
+  std::int64_t counted_slot_ = -1;  // the slot pulses_in_slot_ counts (count_in_slot)
+  int pulses_in_slot_ = 0;
+  std::deque<std::pair<std::uint32_t, StampNs>> recent_pulses_;  // (receiver, stamp) of the last pulses
   int consecutive_far_ = 0;
   std::optional<StartupWait> last_fit_failure_;
   std::uint64_t startup_fits_failed_ = 0;
   std::uint64_t heading_fits_ = 0;
   std::uint64_t losses_ = 0;
+  std::uint64_t silences_ = 0;
 };
 
 }  // namespace beaconloc

@@ -13,8 +13,8 @@ void OdometryTrack::add(const OdometrySample& o, double end_s, double dt_s) {
   i.end_s = end_s;
   i.speed_mps = 0.5 * (o.wheel_velocity_right_mps + o.wheel_velocity_left_mps);
   i.turn_rate_radps = (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / base;
-  i.speed_variance = 0.25 * (c(0, 0) + c(1, 1) + 2.0 * c(0, 1));
-  i.turn_rate_variance = (c(0, 0) + c(1, 1) - 2.0 * c(0, 1)) / (base * base);
+  i.speed_variance_m2ps2 = 0.25 * (c(0, 0) + c(1, 1) + 2.0 * c(0, 1));
+  i.turn_rate_variance_rad2ps2 = (c(0, 0) + c(1, 1) - 2.0 * c(0, 1)) / (base * base);
   intervals_.push_back(i);
 }
 
@@ -39,8 +39,8 @@ DeadReckoning OdometryTrack::between(double from_s, double to_s) const {
     move_along(d, d.dtheta_rad, distance, dtheta);
     d.distance_m += distance;
     d.dtheta_rad += dtheta;
-    d.distance_variance += i.speed_variance * dt * dt;
-    d.dtheta_variance += i.turn_rate_variance * dt * dt;
+    d.distance_variance_m2 += i.speed_variance_m2ps2 * dt * dt;
+    d.dtheta_variance_rad2 += i.turn_rate_variance_rad2ps2 * dt * dt;
   };
   // The first interval that ends after from_s.
   auto it = std::upper_bound(intervals_.begin(), intervals_.end(), from_s,

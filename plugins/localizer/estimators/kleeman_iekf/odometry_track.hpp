@@ -15,16 +15,16 @@ struct OdometryInterval {
   double end_s = 0.0;
   double speed_mps = 0.0;
   double turn_rate_radps = 0.0;
-  double speed_variance = 0.0;      // (m/s)^2, of this interval's speed
-  double turn_rate_variance = 0.0;  // (rad/s)^2
+  double speed_variance_m2ps2 = 0.0;      // (m/s)^2, of this interval's speed
+  double turn_rate_variance_rad2ps2 = 0.0;  // (rad/s)^2
 };
 
 // What the robot did between two instants.
 struct DeadReckoning {
   double distance_m = 0.0;
   double dtheta_rad = 0.0;
-  double distance_variance = 0.0;  // m^2: the intervals' speed noise, independent between intervals
-  double dtheta_variance = 0.0;    // rad^2
+  double distance_variance_m2 = 0.0;  // m^2: the intervals' speed noise, independent between intervals
+  double dtheta_variance_rad2 = 0.0;    // rad^2
   // Displacement in the robot's frame at the span's start (x ahead, y to the left).
   double forward_m = 0.0;
   double left_m = 0.0;

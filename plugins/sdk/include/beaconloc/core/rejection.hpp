@@ -48,7 +48,10 @@ enum class Rejection : std::uint8_t {
   kPulseBetweenSlots,       // later than the longest flight after any firing: not a direct pulse
   kPulseLate,               // of a slot the filter has moved past
   kPulseTooFarAhead,        // further ahead of the filter's cycle than it can step (kMaxSlotsAhead)
-  kStartupFitFailed,        // the start-up fit found no state that explains its arrival times
+  kStartupFitFailed,        // the start-up fit this pulse completed found no state that explains the pulses
+  kDuplicatePulse,          // a receiver's arrival stamp heard already
+  kTooManyPulsesInSlot,     // a flood: more pulses in one slot than echoes explain
+  kBeaconMapUnusable,       // no marked beacon, too few beacons, or slots that would be ambiguous
   // Out-of-sequence fusion (core/out_of_sequence_fusion.hpp).
   kTooLate,
   kAheadOfOdometry,
