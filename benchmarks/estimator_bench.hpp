@@ -51,9 +51,9 @@ inline EstimatorConfig config_for(const sim::Scenario& s) {
 }
 
 // The simulated run (seed `seed`, duration_s) as the estimator's inputs, in arrival order: its
-// TOFs decoded into ranges, or as raw TOFs for an estimator that uses them (raw_tof).
+// beacon measurements as the estimator hears them (beacon_input: decoded ranges, raw TOFs or pulses).
 inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t seed, double duration_s,
-                                           bool raw_tof = false) {
+                                           BeaconInput beacon_input = BeaconInput::kRanges) {
   sim::SimSource source(s, seed);
   std::vector<SourceEvent> events;
   source.advance(s_to_ns(duration_s), events);
@@ -66,7 +66,7 @@ inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t
   std::vector<Input> out;
   for (const SourceEvent& e : events) {
     // As the localizer is given them.
-    if (std::optional<EstimatorInput> in = estimator_input("robot1", e, decoder, raw_tof)) {
+    if (std::optional<EstimatorInput> in = estimator_input("robot1", e, decoder, beacon_input)) {
       out.push_back({std::move(*in), e.truth_map_base});
     }
   }

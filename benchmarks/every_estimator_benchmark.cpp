@@ -25,8 +25,8 @@ void run_estimator(benchmark::State& state, const std::string& name) {
   const sim::Scenario scenario = bench::scenario_file(EstimatorRegistry::instance().reference_scenario(name));
   const EstimatorConfig config = bench::config_for(scenario);
   const BeaconMap map(scenario.beacons);
-  const bool raw_tof = EstimatorRegistry::instance().create(name, config)->uses_raw_tof();
-  const std::vector<bench::Input> inputs = bench::simulated_inputs(scenario, 1, kRunS, raw_tof);
+  const BeaconInput beacon_input = EstimatorRegistry::instance().create(name, config)->beacon_input();
+  const std::vector<bench::Input> inputs = bench::simulated_inputs(scenario, 1, kRunS, beacon_input);
   const std::size_t odometry = bench::count<OdometrySample>(inputs);
   // What it refuses of them (gated, before its first fix, ...), counted once outside the timing:
   // a run that refuses most of its inputs times the checks, not the estimator.

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -20,6 +21,7 @@
 #include "beaconloc/dds/stop_signal.hpp"
 #include "decoder_participant.hpp"
 #include "diagnostics_recorder.hpp"
+#include "estimator_state_recorder.hpp"
 #include "lead_limiter.hpp"
 #include "localizer_participant.hpp"
 #include "options.hpp"
@@ -193,7 +195,7 @@ void print_pose_line(double t_s, const PoseRecorder& recorder) {
 // Scores and writes the outputs shared by both modes.
 PipelineResult finish(const PipelineOptions& o, const LoadedSource& source, const BeaconMap& beacons,
                       const std::vector<RecordedPose>& poses, const TruthTrack& truth,
-                      const std::string& diagnostics) {
+                      const std::string& diagnostics, const std::vector<EstimatorStateRow>& state) {
   PipelineResult r;
   EvaluationOptions eval;
   if (!poses.empty() && o.score_from_ns > 0)
@@ -213,7 +215,9 @@ PipelineResult finish(const PipelineOptions& o, const LoadedSource& source, cons
     write_trajectory_svg(o.out_dir + "/trajectory.svg", title, truth, rows, beacons,
                          source.scenario ? source.scenario->map : std::nullopt);
     write_error_svg(o.out_dir + "/error.svg", title, error_series(truth, rows, eval));
+    if (!state.empty()) write_estimator_state_csv(o.out_dir + "/estimator_state.csv", state);
   }
+  r.estimator_state_rows = state.size();
   return r;
 }
 
@@ -236,15 +240,23 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
   }
   DecoderParticipant decoder(o.dds, o.decoder);
   PoseRecorder recorder(o.dds);
+  EstimatorStateRecorder state_recorder(o.dds);
   DiagnosticsRecorder diagnostics(o.dds);
   std::unique_ptr<GatewayParticipant> gateway;
   std::uint64_t stalls = 0;
   // The streams the gateway is held back on, in this order: odometry (to the localizer), TOFs (to
-  // the decoder) and the decoder's ranges (to the localizer).
+  // the decoder) and the decoder's ranges (to the localizer); from beacons without a radio
+  // message, the pulse arrivals go to the localizer and the decoder has nothing to do.
   enum : std::size_t { kOdometry, kTofs, kRanges };
+  const bool pulses = source.source->beacon_input() == BeaconInput::kPulseArrivals;
   LeadLimiter lead({kMaxOdometryLead, kMaxTofLead, kMaxTofLead});
   auto streams = [&] {
     const auto& written = gateway->progress();
+    if (pulses) {
+      return std::vector<LeadLimiter::Stream>{{written.odometry_written.load(), localizer.odometry_processed()},
+                                              {written.tofs_written.load(), localizer.ranges_processed()},
+                                              {0, 0}};
+    }
     return std::vector<LeadLimiter::Stream>{{written.odometry_written.load(), localizer.odometry_processed()},
                                             {written.tofs_written.load(), decoder.tofs_processed()},
                                             {decoder.ranges_written(), localizer.ranges_processed()}};
@@ -281,7 +293,7 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
         truth.add(stamp, pose, has_yaw);
       },
       o.gateway.speed == 0.0 ? GatewayParticipant::Throttle(throttle) : GatewayParticipant::Throttle());
-  if (!gateway->wait_for_readers(5s) || !decoder.wait_for_readers(5s)) {
+  if (!gateway->wait_for_readers(5s) || (!pulses && !decoder.wait_for_readers(5s))) {
     throw std::runtime_error("the participants did not discover each other within 5 s");
   }
   gateway->start();
@@ -326,7 +338,7 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
   std::ostringstream diag;
   print_diagnostics(diagnostics.reports(), diag);
   std::lock_guard<std::mutex> lock(truth_mutex);
-  return finish(o, described, beacons, recorder.poses(), truth, diag.str());
+  return finish(o, described, beacons, recorder.poses(), truth, diag.str(), state_recorder.rows());
 }
 
 // The arguments a child process is started with: option groups written back (options.hpp).
@@ -349,6 +361,7 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
   const BeaconMap beacons = source.source->beacon_map();
   const ReceiverArray receivers = source.source->receivers();
   PoseRecorder recorder(o.dds);
+  EstimatorStateRecorder state_recorder(o.dds);
   DiagnosticsRecorder diagnostics(o.dds);
 
   const LocalizerSettings localizer_settings = with_scenario_defaults(o.localizer, source, o.out_dir);
@@ -369,10 +382,15 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
   const std::vector<std::string> gateway_args = command_line(
       "gateway", dds_option_set(dds), gateway_option_set(gateway_options, seed), source_option_set(choice));
 
+  // From beacons without a radio message the gateway's pulse arrivals go to the localizer: no
+  // decoder (it would have nothing to decode).
+  const bool pulses = source.source->beacon_input() == BeaconInput::kPulseArrivals;
   ChildProcess localizer(exe, localizer_args, o.out_dir + "/localizer.log");
-  ChildProcess decoder(exe, decoder_args, o.out_dir + "/decoder.log");
-  wait_until_reporting(diagnostics, {{"beaconloc.decoder", &decoder},
-                                     {"beaconloc.localizer." + o.localizer.estimator, &localizer}});
+  std::optional<ChildProcess> decoder;
+  if (!pulses) decoder.emplace(exe, decoder_args, o.out_dir + "/decoder.log");
+  std::vector<std::pair<std::string, ChildProcess*>> reporting{{"beaconloc.localizer." + o.localizer.estimator, &localizer}};
+  if (decoder) reporting.emplace_back("beaconloc.decoder", &*decoder);
+  wait_until_reporting(diagnostics, reporting);
   ChildProcess gateway(exe, gateway_args, o.out_dir + "/gateway.log");
   const auto start = std::chrono::steady_clock::now();
   const double total_s = o.gateway.duration_s > 0.0
@@ -390,19 +408,22 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
   }
   const int gateway_code = gateway.wait(dds::stop_requested() ? 0ms : 10s);
   if (!dds::stop_requested()) wait_until_drained(recorder);
-  decoder.terminate();
+  if (decoder) decoder->terminate();
   localizer.terminate();
-  const int decoder_code = decoder.wait(15s), localizer_code = localizer.wait(15s);
+  const int decoder_code = decoder ? decoder->wait(15s) : 0, localizer_code = localizer.wait(15s);
   if (gateway_code != 0 || decoder_code != 0 || localizer_code != 0) {
     throw std::runtime_error("a participant failed (exit codes gateway " + std::to_string(gateway_code) +
                              ", decoder " + std::to_string(decoder_code) + ", localizer " +
                              std::to_string(localizer_code) + "); logs in " + o.out_dir);
   }
-  wait_until_left(diagnostics, {"beaconloc.gateway." + o.gateway.robot_id, "beaconloc.decoder",
-                                "beaconloc.localizer." + o.localizer.estimator});
+  std::vector<std::string> participants{"beaconloc.gateway." + o.gateway.robot_id,
+                                        "beaconloc.localizer." + o.localizer.estimator};
+  if (decoder) participants.push_back("beaconloc.decoder");
+  wait_until_left(diagnostics, participants);
   std::ostringstream diag;
   print_diagnostics(diagnostics.reports(), diag);
-  return finish(o, source, beacons, recorder.poses(), load_truth_csv(o.out_dir + "/truth.csv"), diag.str());
+  return finish(o, source, beacons, recorder.poses(), load_truth_csv(o.out_dir + "/truth.csv"), diag.str(),
+                state_recorder.rows());
 }
 
 std::vector<std::pair<std::string, std::string>> split_pairs(const std::string& text, char outer,

@@ -75,10 +75,12 @@ struct PipelineResult {
   Metrics metrics;
   std::size_t truth_samples = 0;  // 0: the source has no ground truth (a replay without gt.csv)
   std::string diagnostics;        // each participant's counts, one line each
+  std::size_t estimator_state_rows = 0;  // written to estimator_state.csv (estimators with such state)
 };
 
 // Runs to the end of the source (or the duration), then evaluates. With out_dir, writes
-// truth.csv, estimate.csv, beacons.csv, metrics.json, trajectory.svg and error.svg there.
+// truth.csv, estimate.csv, beacons.csv, metrics.json, trajectory.svg and error.svg there, and
+// estimator_state.csv when the estimator published state beside its poses (EstimatorState).
 PipelineResult run_pipeline(const PipelineOptions& options, LoadedSource source, const std::string& self_exe);
 
 // `beaconloc eval`: metrics.json, trajectory.svg and error.svg from a truth and an estimate CSV.

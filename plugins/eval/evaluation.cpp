@@ -98,6 +98,7 @@ Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estima
   PoseErrorAccumulator heading;
   double sum_es = 0;
   std::size_t in_band = 0;
+  std::vector<double> path_errors;
   for (const auto& [row, t] : scored) {
     const Pose2& est = row->estimate.pose_map_base;
     const Pose2& gt = t.pose_map_base;
@@ -109,6 +110,8 @@ Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estima
         es_sq += (transform_point(gt, p) - transform_point(est, p)).squaredNorm();
       }
       sum_es += std::sqrt(es_sq / static_cast<double>(significant_points_base_m().size()));
+      const Eigen::Vector2d left(-std::sin(gt.z()), std::cos(gt.z()));
+      path_errors.push_back((est.head<2>() - gt.head<2>()).dot(left));
     }
     double nees;
     if (m.nees_dof == 3) {
@@ -130,6 +133,16 @@ Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estima
   if (heading.samples()) {
     m.heading_rms_deg = heading.heading_rms_deg();
     m.significant_points_mean_m = sum_es / static_cast<double>(heading.samples());
+    double mean = 0.0, max_abs = 0.0;
+    for (const double e : path_errors) {
+      mean += e;
+      max_abs = std::max(max_abs, std::abs(e));
+    }
+    mean /= static_cast<double>(path_errors.size());
+    double var = 0.0;
+    for (const double e : path_errors) var += (e - mean) * (e - mean);
+    m.path_error_std_m = std::sqrt(var / static_cast<double>(path_errors.size()));
+    m.path_error_max_m = max_abs;
   }
   return m;
 }

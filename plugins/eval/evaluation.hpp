@@ -35,6 +35,11 @@ struct Metrics {
   double position_max_m = 0.0;
   std::optional<double> heading_rms_deg;            // where truth has heading
   std::optional<double> significant_points_mean_m;  // eq. 35, where truth has heading
+  // Seed 002 Sec. 4's path error: the signed distance from the true path, left positive, taken
+  // across the true heading at the pose's stamp (on a straight leg, the distance to the path the
+  // paper measured; a lag along the path does not count). Where truth has heading.
+  std::optional<double> path_error_std_m;
+  std::optional<double> path_error_max_m;  // of its magnitude
   double nees_in_band_fraction = 0.0;
   int nees_dof = 3;  // 3 with heading in the truth, else 2 (position only)
 };

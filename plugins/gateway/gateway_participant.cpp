@@ -23,6 +23,7 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
       participant_(dds, "beaconloc.gateway." + options_.robot_id),
       map_writer_(participant_.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic)),
       tof_writer_(participant_.writer<msg::RawTofPubSubType>(dds::kRawTofTopic)),
+      pulse_writer_(participant_.writer<msg::PulseArrivalPubSubType>(dds::kPulseArrivalTopic)),
       odometry_writer_(participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic)),
       scan_writer_(participant_.writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic)) {
   if (!(options_.speed == 0.0 ||
@@ -47,6 +48,11 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
     record_tof_ << "fire_stamp_ns,beacon_id,receiver_id,tof_s,beacon_temperature_c,sequence_number,"
                    "true_beacon_id,echo\n"
                 << std::setprecision(12);
+    if (source_->beacon_input() == BeaconInput::kPulseArrivals) {
+      record_pulse_.open(options_.record_dir + "/pulse.csv");
+      if (!record_pulse_) throw std::runtime_error("cannot write pulse.csv in '" + options_.record_dir + "'");
+      record_pulse_ << "arrival_stamp_ns,receiver_id,mark,sequence_number,true_beacon_id,echo\n";
+    }
     record_odometry_
         << "stamp_ns,wheel_velocity_right_mps,wheel_velocity_left_mps,wheel_base_m,var_right,var_left\n"
         << std::setprecision(12);
@@ -58,6 +64,7 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
   // hears no beacon, waits for a slow pipeline or replays a gap in a recording stays alive.
   liveliness_ = std::make_unique<dds::PeriodicTask>(std::chrono::milliseconds(250), [this] {
     tof_writer_->assert_liveliness();
+    pulse_writer_->assert_liveliness();
     odometry_writer_->assert_liveliness();
   });
   diagnostics_ = std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] {
@@ -76,7 +83,8 @@ GatewayParticipant::~GatewayParticipant() {
 }
 
 bool GatewayParticipant::wait_for_readers(std::chrono::milliseconds timeout) const {
-  return dds::wait_for_matched_readers({tof_writer_, odometry_writer_}, timeout);
+  const bool pulses = source_->beacon_input() == BeaconInput::kPulseArrivals;
+  return dds::wait_for_matched_readers({pulses ? pulse_writer_ : tof_writer_, odometry_writer_}, timeout);
 }
 
 void GatewayParticipant::start() {
@@ -126,6 +134,18 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
       }
       auto m = dds::to_msg(options_.robot_id, e.tof);
       count(tof_writer_->write(&m));  // bool in Fast DDS 2.9 (TOOLCHAIN.md)
+      ++progress_.tofs_written;
+      break;
+    }
+    case SourceEvent::Kind::kPulse: {
+      e.pulse.stamp_ns = stamp;
+      if (record_pulse_.is_open()) {
+        const auto& p = e.pulse;
+        record_pulse_ << p.stamp_ns << ',' << p.receiver_id << ',' << to_string(p.mark) << ',' << p.sequence_number
+                      << ',' << e.true_beacon_id << ',' << e.tof_is_echo << '\n';
+      }
+      auto m = dds::to_msg(options_.robot_id, e.pulse);
+      count(pulse_writer_->write(&m));
       ++progress_.tofs_written;
       break;
     }

@@ -44,7 +44,7 @@ struct GatewayOptions {
 // What the gateway has written so far (read by a throttle in the same process).
 struct GatewayProgress {
   std::atomic<std::uint64_t> odometry_written{0};
-  std::atomic<std::uint64_t> tofs_written{0};
+  std::atomic<std::uint64_t> tofs_written{0};  // beacon measurements: RawTof or PulseArrival samples
   std::atomic<StampNs> newest_stamp_ns{0};
 };
 
@@ -58,9 +58,12 @@ class GatewayParticipant {
   GatewayParticipant(const dds::DdsOptions& dds, GatewayOptions options, std::unique_ptr<Source> source,
                      TruthCallback on_truth = {}, Throttle throttle = {});
   ~GatewayParticipant();
-  // Waits until the TOF and odometry writers each have a matched reader (false on timeout), so
-  // that a run in one process loses none of its first samples.
+  // Waits until the odometry writer and the writer of the source's beacon measurements (TOFs or
+  // pulse arrivals) each have a matched reader (false on timeout), so that a run in one process
+  // loses none of its first samples.
   bool wait_for_readers(std::chrono::milliseconds timeout) const;
+  // How the source hears its beacons (Source::beacon_input): RawTof or PulseArrival samples.
+  BeaconInput beacon_input() const { return source_->beacon_input(); }
   void start();
   void stop();
   void publish_diagnostics() { diagnostics_->publish_now(); }
@@ -86,10 +89,12 @@ class GatewayParticipant {
   // declared after them, so stops before they go.
   dds::Writer map_writer_;
   dds::Writer tof_writer_;
+  dds::Writer pulse_writer_;
   dds::Writer odometry_writer_;
   dds::Writer scan_writer_;
   std::ofstream truth_;
   std::ofstream record_tof_;
+  std::ofstream record_pulse_;
   std::ofstream record_odometry_;
   std::uint64_t odometry_sequence_ = 0;
   std::mutex counts_mutex_;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "beaconloc/core/beacon_map.hpp"
+#include "beaconloc/core/estimator.hpp"
 #include "beaconloc/core/measurements.hpp"
 #include "beaconloc/core/pose2.hpp"
 #include "beaconloc/core/receiver_array.hpp"
@@ -14,14 +15,15 @@
 namespace beaconloc {
 
 struct SourceEvent {
-  enum class Kind { kOdometry, kTof, kLaserScan, kTruth };
+  enum class Kind { kOdometry, kTof, kPulse, kLaserScan, kTruth };
   Kind kind = Kind::kOdometry;
-  StampNs stamp_ns = 0;  // odometry stamp, arrival of a pulse, scan or truth time
+  StampNs stamp_ns = 0;  // odometry stamp, arrival of a pulse (kTof, kPulse), scan or truth time
 
   OdometrySample odometry;                             // kOdometry
   RawTofSample tof;                                    // kTof
-  std::uint32_t true_beacon_id = kBeaconUnidentified;  // kTof: who fired, for evaluation only
-  bool tof_is_echo = false;                            // kTof: simulated echo, for evaluation only
+  PulseArrivalSample pulse;                            // kPulse
+  std::uint32_t true_beacon_id = kBeaconUnidentified;  // kTof, kPulse: who fired, for evaluation only
+  bool tof_is_echo = false;                            // kTof, kPulse: simulated echo, for evaluation only
   LaserScanSample scan;                                // kLaserScan
 
   // Ground truth at stamp_ns: on kTruth events, and on the simulator's kOdometry events.
@@ -49,6 +51,9 @@ class Source {
   // clock. A recording keeps its own clock.
   virtual bool relative_stamps() const = 0;
   virtual std::string describe() const = 0;
+  // How its beacons are heard: times of flight (kTof events, RawTof) or, from beacons without a
+  // radio message, pulse arrivals (kPulse events, PulseArrival). Never decoded ranges.
+  virtual BeaconInput beacon_input() const { return BeaconInput::kRawTof; }
   // Input the source refused while reading it (a recording's malformed rows), by reason.
   virtual RejectionCounter input_rejections() const { return {}; }
 };

@@ -1,5 +1,7 @@
 #include "localizer_core.hpp"
 
+#include <cmath>
+
 #include "beaconloc/core/estimator_registry.hpp"
 
 namespace beaconloc {
@@ -11,7 +13,7 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
   // Fail at start, not at the first sample, when the name or the configuration is wrong.
   const auto probe = EstimatorRegistry::instance().create(estimator_name_, config_);
   uses_laser_ = probe->uses_laser();
-  uses_raw_tof_ = probe->uses_raw_tof();
+  beacon_input_ = probe->beacon_input();
 }
 
 bool LocalizerCore::on_beacon_map(const std::vector<Beacon>& beacons) {
@@ -102,8 +104,23 @@ std::optional<LocalizerOutput> LocalizerCore::output(const std::string& robot_id
     return std::nullopt;
   }
   estimate->status = r.status();
-  LocalizerOutput out{robot_id, *estimate, {r.beacons_used.begin(), r.beacons_used.end()}};
+  LocalizerOutput out{robot_id, *estimate, {r.beacons_used.begin(), r.beacons_used.end()}, {}};
   r.beacons_used.clear();
+  // Compared as a difference: a stamp near the clock's end must not overflow.
+  if (!r.state_sent_ns || estimate->stamp_ns < *r.state_sent_ns ||
+      estimate->stamp_ns - *r.state_sent_ns >= kEstimatorStatePeriodNs) {
+    out.state = r.fusion.estimator().state_values();
+    // Like a pose, never a non-finite number out: an estimator whose state is not finite has a
+    // pose no better (and publishable() would have caught most); the state is dropped, counted.
+    for (const Estimator::StateValue& v : out.state) {
+      if (!std::isfinite(v.value) || !std::isfinite(v.sigma) || !(v.sigma >= 0.0)) {
+        counts_.reject("estimate.unusable_state");
+        out.state.clear();
+        break;
+      }
+    }
+    if (!out.state.empty()) r.state_sent_ns = estimate->stamp_ns;
+  }
   return out;
 }
 
@@ -123,7 +140,7 @@ std::optional<LocalizerOutput> LocalizerCore::correction_output(const std::strin
 
 std::optional<LocalizerOutput> LocalizerCore::on_range(const std::string& robot_id,
                                                        const RangeMeasurement& range) {
-  return on_input(robot_id, range);  // none if uses_raw_tof(): the participant does not subscribe then
+  return on_input(robot_id, range);  // none unless beacon_input() is kRanges: not subscribed then
 }
 
 std::optional<LocalizerOutput> LocalizerCore::on_laser(const std::string& robot_id,
@@ -132,16 +149,22 @@ std::optional<LocalizerOutput> LocalizerCore::on_laser(const std::string& robot_
 }
 
 std::optional<LocalizerOutput> LocalizerCore::on_raw_tof(const std::string& robot_id, const RawTofSample& tof) {
-  return on_input(robot_id, tof);  // none unless uses_raw_tof(): the participant does not subscribe then
+  return on_input(robot_id, tof);  // none unless beacon_input() is kRawTof: not subscribed then
+}
+
+std::optional<LocalizerOutput> LocalizerCore::on_pulse(const std::string& robot_id, const PulseArrivalSample& pulse) {
+  return on_input(robot_id, pulse);  // none unless beacon_input() is kPulseArrivals: not subscribed then
 }
 
 std::optional<LocalizerOutput> LocalizerCore::on_input(const std::string& robot_id, EstimatorInput input) {
   if (const auto* odometry = std::get_if<OdometrySample>(&input)) return on_odometry(robot_id, *odometry);
   // What the estimator does not take, the participant does not subscribe to: scans for an
-  // estimator without a laser model; raw TOFs for one of decoded ranges, ranges for one of raw TOFs.
-  if (std::holds_alternative<LaserScanSample>(input) && !uses_laser_) return std::nullopt;
-  if (std::holds_alternative<RawTofSample>(input) && !uses_raw_tof_) return std::nullopt;
-  if (std::holds_alternative<RangeMeasurement>(input) && uses_raw_tof_) return std::nullopt;
+  // estimator without a laser model; beacon measurements of another kind than its beacon_input().
+  if (std::holds_alternative<LaserScanSample>(input)) {
+    if (!uses_laser_) return std::nullopt;
+  } else if (!is_beacon_input(input, beacon_input_)) {
+    return std::nullopt;
+  }
   return on_measurement(robot_id, std::move(input));
 }
 
@@ -159,8 +182,9 @@ std::optional<LocalizerOutput> LocalizerCore::on_measurement(const std::string& 
   Robot* r = robot(robot_id, kind.c_str());
   if (!r) return std::nullopt;
   const std::optional<std::uint32_t> beacon = beacon_of(input);
-  // The bus delivers beacon measurements again; whether they fit is the estimator's call.
-  if (beacon) r->ranges_silent = false;
+  // The bus delivers beacon measurements again (of any kind, pulses too); whether they fit is the
+  // estimator's call.
+  if (is_beacon_input(input, beacon_input_)) r->ranges_silent = false;
   const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
   const InputResult result = r->fusion.push(std::move(input));
   if (!result.accepted) {

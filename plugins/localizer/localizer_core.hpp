@@ -19,7 +19,14 @@ struct LocalizerOutput {
   std::string robot_id;
   PoseEstimate estimate;
   std::vector<std::uint32_t> beacons_used;  // beacons fused since the previous output
+  // The estimator's state beside the pose (Estimator::state_values), once per
+  // kEstimatorStatePeriodNs of the robot's data time; empty between, and for most estimators.
+  std::vector<Estimator::StateValue> state;
 };
+
+// How often a robot's estimator state goes out: a second of data time (plots over minutes, as
+// seed 002's Fig. 8; a hundred times fewer samples than the poses).
+inline constexpr StampNs kEstimatorStatePeriodNs = 1'000'000'000;
 
 // Why the robots without a pose have none: how many wait for each start-up condition, and the
 // first of them (by robot id) with the numbers that matter. Short for many robots.
@@ -62,11 +69,12 @@ class LocalizerCore {
   // Laser scans reach estimators that use them (uses_laser()); others never see one.
   bool uses_laser() const { return uses_laser_; }
   std::optional<LocalizerOutput> on_laser(const std::string& robot_id, const LaserScanSample& scan);
-  // Raw times of flight reach estimators that turn them into ranges themselves (uses_raw_tof(),
-  // seed 002), and are never given decoded ranges; the others are given decoded ranges and never
-  // see a raw TOF.
-  bool uses_raw_tof() const { return uses_raw_tof_; }
+  // Each estimator hears the beacons one way (Estimator::beacon_input): decoded ranges, raw times
+  // of flight, or pulse arrivals (seed 002); the participant subscribes to that topic alone, and
+  // the other kinds never reach the estimator (each pulse reaches it once).
+  BeaconInput beacon_input() const { return beacon_input_; }
   std::optional<LocalizerOutput> on_raw_tof(const std::string& robot_id, const RawTofSample& tof);
+  std::optional<LocalizerOutput> on_pulse(const std::string& robot_id, const PulseArrivalSample& pulse);
   // Restarts the robot's estimator from a given pose (counted as initial_pose.<reason> if refused).
   void on_initial_pose(const std::string& robot_id, StampNs stamp_ns, const Pose2& pose_map_base,
                        const Cov3& covariance);
@@ -92,6 +100,12 @@ class LocalizerCore {
   }
   const RejectionCounter& counts() const { return counts_; }  // reasons prefixed odometry./range.
   std::size_t robot_count() const { return robots_.size(); }
+  // The robot's estimator (for evaluation: an estimator's own state beside its pose); null for a
+  // robot not seen.
+  const Estimator* estimator(const std::string& robot_id) const {
+    const auto it = robots_.find(robot_id);
+    return it == robots_.end() ? nullptr : &it->second.fusion.estimator();
+  }
   std::vector<std::string> robot_ids() const;  // the robots it has an estimator for, sorted
   // The worst status over the robots served (kOk when none).
   PoseStatus worst_status() const;
@@ -108,6 +122,7 @@ class LocalizerCore {
     int odometry_deadlines_missed = 0;  // in a row, since the robot's last odometry sample
     bool odometry_silent() const { return odometry_deadlines_missed >= kOdometrySilentAfterMisses; }
     std::optional<StampNs> jump_candidate_ns;  // an odometry stamp far behind the time line
+    std::optional<StampNs> state_sent_ns;      // stamp of the last output that carried the state
     PoseStatus status() const;
   };
   // Two odometry samples in a row more than kClockJumpMinNs behind the time line, and at most
@@ -136,7 +151,7 @@ class LocalizerCore {
   EstimatorConfig config_;
   std::string robot_filter_;
   bool uses_laser_ = false;
-  bool uses_raw_tof_ = false;
+  BeaconInput beacon_input_ = BeaconInput::kRanges;
   BeaconMap map_;
   std::map<std::string, Robot> robots_;
   RejectionCounter counts_;

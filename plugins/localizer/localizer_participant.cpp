@@ -47,7 +47,8 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
     : core_(std::move(core)),
       conflicts_(std::chrono::duration_cast<std::chrono::nanoseconds>(dds::kDiagnosticsSilentAfter).count()),
       participant_(dds, "beaconloc.localizer." + core_.estimator_name()),
-      pose_writer_(participant_.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic)) {
+      pose_writer_(participant_.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic)),
+      state_writer_(participant_.writer<msg::EstimatorStatePubSubType>(dds::kEstimatorStateTopic)) {
   // Every writer's map is remembered: two live gateways with different maps are reported.
   dds::ReaderEvents<msg::BeaconMap> map_events;
   map_events.on_writer_gone = [this](const std::string& writer) {
@@ -67,19 +68,26 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
         }
       },
       map_events));
-  // The beacon measurements: the decoder's ranges, or for an estimator that turns times of flight
-  // into ranges itself (it estimates the speed of sound, seed 002) the gateway's raw TOFs; never
-  // both. A robot whose measurements miss their deadline (two beacon slots) coasts on odometry,
+  // The beacon measurements, as the estimator hears them (beacon_input): the decoder's ranges,
+  // the gateway's raw TOFs, or its pulse arrivals (seed 002); never two kinds. A robot whose measurements miss their deadline (two beacon slots) coasts on odometry,
   // degraded; a writer that dies or hangs (liveliness, lease 1 s) is reported, not only felt as
   // silence.
-  if (core_.uses_raw_tof()) {
-    subscribe_beacon_measurements<msg::RawTofPubSubType>(dds::kRawTofTopic, [this](const msg::RawTof& m) {
-      return core_.on_raw_tof(m.robot_id(), dds::from_msg(m));
-    });
-  } else {
-    subscribe_beacon_measurements<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic, [this](const msg::BeaconRange& m) {
-      return core_.on_range(m.robot_id(), dds::from_msg(m));
-    });
+  switch (core_.beacon_input()) {
+    case BeaconInput::kRawTof:
+      subscribe_beacon_measurements<msg::RawTofPubSubType>(dds::kRawTofTopic, [this](const msg::RawTof& m) {
+        return core_.on_raw_tof(m.robot_id(), dds::from_msg(m));
+      });
+      break;
+    case BeaconInput::kPulseArrivals:
+      subscribe_beacon_measurements<msg::PulseArrivalPubSubType>(
+          dds::kPulseArrivalTopic,
+          [this](const msg::PulseArrival& m) { return core_.on_pulse(m.robot_id(), dds::from_msg(m)); });
+      break;
+    case BeaconInput::kRanges:
+      subscribe_beacon_measurements<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic, [this](const msg::BeaconRange& m) {
+        return core_.on_range(m.robot_id(), dds::from_msg(m));
+      });
+      break;
   }
   // The gateway's odometry writer: liveliness tells a dead gateway from a robot standing still.
   dds::ReaderEvents<msg::Odometry> odometry_events;
@@ -177,6 +185,20 @@ void LocalizerParticipant::publish(const LocalizerOutput& out) {
   auto p = dds::to_msg(out.robot_id, estimate, core_.estimator_name(), out.beacons_used);
   pose_writer_->write(&p);
   ++poses_written_;
+  if (!out.state.empty()) {
+    msg::EstimatorState state;
+    state.robot_id(out.robot_id);
+    state.stamp_ns(estimate.stamp_ns);
+    state.estimator(core_.estimator_name());
+    for (const Estimator::StateValue& v : out.state) {
+      msg::EstimatorStateValue value;
+      value.name(v.name);
+      value.value(v.value);
+      value.sigma(v.sigma);
+      state.values().push_back(value);
+    }
+    state_writer_->write(&state);
+  }
 }
 
 msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {

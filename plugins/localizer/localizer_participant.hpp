@@ -70,6 +70,7 @@ class LocalizerParticipant {
   // The entities, owned: the readers, declared last, stop first, before what they use goes.
   dds::Participant participant_;
   dds::Writer pose_writer_;
+  dds::Writer state_writer_;  // EstimatorState: what the estimator holds beside the pose
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
   std::vector<dds::Reader> readers_;
 };

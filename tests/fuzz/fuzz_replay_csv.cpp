@@ -1,6 +1,7 @@
 // Fuzz target: the replay readers (plugins/gateway/replay/replay_source.cpp over
 // plugins/sdk/src/csv_reader.cpp; format in docs/replay-format.md). Input: beacons.csv, odom.csv,
-// ranges.csv and gt.csv, separated by lines "%%" (a file the input lacks is absent). The
+// ranges.csv, gt.csv and pulses.csv, separated by lines "%%" (a file the input lacks, or whose
+// part is empty, is absent). The
 // recording must load or throw ReplayError; a bad row is refused and counted, never a crash,
 // undefined behaviour, a hang or another exception type. What loads must replay: every event,
 // in stamp order.
@@ -26,8 +27,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace beaconloc;
   const auto parts = fuzz::split_parts(data, size);
   const auto& dir = fuzz::scratch_dir();
-  const char* files[] = {"beacons.csv", "odom.csv", "ranges.csv", "gt.csv"};
-  for (std::size_t i = 0; i < 4; ++i) fuzz::write_or_remove(dir / files[i], parts, i);
+  const char* files[] = {"beacons.csv", "odom.csv", "ranges.csv", "gt.csv", "pulses.csv"};
+  // An empty part is an absent file: a recording of pulses has no ranges.csv.
+  for (std::size_t i = 0; i < 5; ++i) {
+    if (i < parts.size() && parts[i].empty()) {
+      std::error_code ignored;
+      std::filesystem::remove(dir / files[i], ignored);
+    } else {
+      fuzz::write_or_remove(dir / files[i], parts, i);
+    }
+  }
   std::unique_ptr<ReplaySource> replay;
   try {
     replay = std::make_unique<ReplaySource>(dir.string());
@@ -48,6 +57,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       case SourceEvent::Kind::kTof:
         check(std::isfinite(e.tof.tof_s));
+        break;
+      case SourceEvent::Kind::kPulse:
+        check(e.pulse.stamp_ns == e.stamp_ns && e.stamp_ns >= 0);
         break;
       case SourceEvent::Kind::kTruth:
         check(e.truth_map_base.allFinite());

@@ -185,6 +185,30 @@ TEST_F(Run, UkfFusesLaserAndAnonymousBeaconsAcrossProcesses) {
   EXPECT_EQ(out.find("out_of_range_tof"), std::string::npos) << out;
 }
 
+// Seed 002 through DDS, one process per participant: beacons without a radio message, so the
+// gateway publishes pulse arrivals (beaconloc/pulse_arrival) straight to kleeman_iekf, which names
+// the beacons by their firing order; no decoder is started.
+TEST_F(Run, PulseArrivalsReachKleemanAcrossProcessesWithoutADecoder) {
+  const auto [code, out] = beaconloc({"run", "--processes", "--speed", kProcessesSpeed, "--duration-s", "25",
+                                      "--scenario", kSource + "/examples/scenarios/seed002_kleeman.yaml",
+                                      "--estimator", "kleeman_iekf", "--out", dir_});
+  ASSERT_EQ(code, 0) << out;
+  const std::string metrics = read(dir_ + "/metrics.json");
+  EXPECT_GT(json_number(metrics, "samples"), 2000) << out;  // 25 s of 100 Hz odometry from the first fix at ~2 s
+  EXPECT_LT(json_number(metrics, "position_rms_m"), 0.1) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ + "/decoder.log"));
+  EXPECT_EQ(out.find("beaconloc.decoder"), std::string::npos) << out;
+  // The speed of sound it estimates, once a second over the bus (EstimatorState), as a CSV.
+  const std::string state = read(dir_ + "/estimator_state.csv");
+  EXPECT_EQ(state.rfind("robot_id,stamp_ns,estimator,name,value,sigma\n", 0), 0u) << state;
+  std::size_t speeds = 0;
+  for (std::size_t at = state.find(",speed_of_sound_mps,"); at != std::string::npos;
+       at = state.find(",speed_of_sound_mps,", at + 1)) {
+    ++speeds;
+  }
+  EXPECT_GE(speeds, 15u) << state;  // a row a second from the first fix at ~2 s
+}
+
 TEST_F(Run, ScenarioErrorsAreReportedWithTheFile) {
   std::ofstream(dir_ + "/bad.yaml") << "name: x\nbeacons: [{id: 1, position_m: [0, 0]}]\n";
   const auto [code, out] = beaconloc({"run", "--scenario", dir_ + "/bad.yaml", "--out", dir_ + "/o"});

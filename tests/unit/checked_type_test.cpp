@@ -71,6 +71,33 @@ TEST(CheckedType, ARangeAssociationTheIdlDoesNotDefineIsRefusedNotReadAsIdentifi
   }
 }
 
+TEST(CheckedType, APulseMarkTheIdlDoesNotDefineIsRefusedNotReadAsADoubleBurst) {
+  msg::PulseArrival p;
+  p.robot_id("r");
+  for (auto m : {msg::PULSE_MARK_NOT_REPORTED, msg::PULSE_MARK_SINGLE, msg::PULSE_MARK_DOUBLE}) {
+    p.mark(m);
+    EXPECT_EQ(round_trip<msg::PulseArrivalPubSubType>(p), std::make_pair(true, std::uint64_t{0}));
+  }
+  for (std::uint32_t v : {std::uint32_t{3}, kUndefined[1], kUndefined[3]}) {
+    p.mark(static_cast<msg::PulseMark>(v));
+    EXPECT_EQ(round_trip<msg::PulseArrivalPubSubType>(p), std::make_pair(false, std::uint64_t{1})) << v;
+  }
+}
+
+TEST(CheckedType, AnEstimatorStateValueNameThatBreaksACsvCellIsRefused) {
+  msg::EstimatorState s;
+  s.robot_id("r");
+  s.estimator("kleeman_iekf");
+  msg::EstimatorStateValue v;
+  v.name("speed_of_sound_mps");
+  s.values().push_back(v);
+  EXPECT_EQ(round_trip<msg::EstimatorStatePubSubType>(s), std::make_pair(true, std::uint64_t{0}));
+  for (const char* bad : {"speed,of_sound", "speed\nx", "\"s\""}) {
+    s.values()[0].name(bad);
+    EXPECT_EQ(round_trip<msg::EstimatorStatePubSubType>(s), std::make_pair(false, std::uint64_t{1})) << bad;
+  }
+}
+
 TEST(CheckedType, AStringWithAControlCharacterOrANameThatBreaksACsvCellIsRefusedOnEveryTopic) {
   const std::string forged[] = {"robot1\nmonitor: 0 poses", "\x1b[2Jr", "r\x7f", "r\tb", "r\xc2\x9b" "2J"};
   for (const std::string& bad : forged) {

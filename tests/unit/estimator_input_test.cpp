@@ -10,6 +10,8 @@
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/out_of_sequence_fusion.hpp"
 #include "localizer_core.hpp"
+#include "offline_run.hpp"
+#include "sim/scenario_yaml.hpp"
 #include "standing_odometry.hpp"
 
 namespace beaconloc {
@@ -23,7 +25,7 @@ class RecordingEstimator : public Estimator {
   std::string name() const override { return "test_recording"; }
   void set_beacon_map(const BeaconMap&) override {}
   bool uses_laser() const override { return true; }
-  bool uses_raw_tof() const override { return true; }
+  BeaconInput beacon_input() const override { return BeaconInput::kRawTof; }
   InputResult predict(const OdometrySample& o) override { return note("odometry", o.stamp_ns); }
   InputResult update(const RangeMeasurement& r) override { return note("range", r.stamp_ns); }
   InputResult update_laser(const LaserScanSample& s) override { return note("laser", s.stamp_ns); }
@@ -93,6 +95,10 @@ TEST(EstimatorInput, KindsAreNamedAndStampedOnce) {
   EXPECT_EQ(stamp_of(range_at(12)), 12);
   EXPECT_EQ(stamp_of(scan_at(13)), 13);
   EXPECT_EQ(stamp_of(tof_fired_at(14)), 14);  // the firing; the arrival needs the speed of sound
+  PulseArrivalSample pulse;
+  pulse.stamp_ns = 15;
+  EXPECT_STREQ(kind_name(pulse), "pulse");
+  EXPECT_EQ(stamp_of(pulse), 15);  // the arrival: there is no firing time
   EXPECT_TRUE(is_odometry(odometry_at(1)));
   EXPECT_FALSE(is_odometry(tof_fired_at(1)));
 }
@@ -101,7 +107,7 @@ TEST(EstimatorInput, AnEstimatorOfDecodedRangesRefusesARawTof) {
   EstimatorConfig config;
   config.receivers = ReceiverArray::on_circle(0.19, 3);
   const auto e = EstimatorRegistry::instance().create("range_ekf", config);
-  EXPECT_FALSE(e->uses_raw_tof());
+  EXPECT_EQ(e->beacon_input(), BeaconInput::kRanges);
   EXPECT_EQ(e->push(tof_fired_at(1)).rejection, Rejection::kRawTofUnused);
 }
 
@@ -124,7 +130,7 @@ TEST(EstimatorInput, TheLocalizerGivesRawTofsOnlyToEstimatorsThatUseThemAndThemN
   EstimatorConfig config;
   config.receivers = ReceiverArray::on_circle(0.19, 3);
   LocalizerCore raw("test_recording", config);
-  ASSERT_TRUE(raw.uses_raw_tof());
+  ASSERT_EQ(raw.beacon_input(), BeaconInput::kRawTof);
   raw.on_odometry("r", odometry_at(0));
   EXPECT_TRUE(raw.on_raw_tof("r", tof_fired_at(5)).has_value());  // fused: the corrected pose goes out
   EXPECT_FALSE(raw.on_raw_tof("r", tof_fired_at(6, -1.0)).has_value());
@@ -135,10 +141,96 @@ TEST(EstimatorInput, TheLocalizerGivesRawTofsOnlyToEstimatorsThatUseThemAndThemN
   EXPECT_EQ(raw.counts().accepted(), 2u);  // the odometry sample and the one good raw TOF
 
   LocalizerCore ranges("range_ekf", config);
-  EXPECT_FALSE(ranges.uses_raw_tof());
+  EXPECT_EQ(ranges.beacon_input(), BeaconInput::kRanges);
   ranges.on_odometry("r", odometry_at(0));
   EXPECT_FALSE(ranges.on_raw_tof("r", tof_fired_at(5)).has_value());  // never subscribed: never given one
   EXPECT_EQ(ranges.counts().rejected("raw_tof.raw_tof_unused"), 0u);
+}
+
+// Pulse arrivals (seed 002) reach only an estimator that hears the beacons that way, which is
+// never given ranges or raw TOFs; the others never see a pulse (counted nowhere: not subscribed).
+TEST(EstimatorInput, TheLocalizerGivesPulseArrivalsOnlyToEstimatorsThatHearThem) {
+  EstimatorConfig config;
+  config.receivers.receivers_base_m = {{0.0, 0.0}};
+  LocalizerCore pulses("kleeman_iekf", config);
+  ASSERT_EQ(pulses.beacon_input(), BeaconInput::kPulseArrivals);
+  pulses.on_odometry("r", odometry_at(0));
+  PulseArrivalSample before_sync;
+  before_sync.stamp_ns = 5;
+  before_sync.mark = PulseMark::kSingle;
+  pulses.on_pulse("r", before_sync);
+  pulses.on_range("r", range_at(7));
+  pulses.on_raw_tof("r", tof_fired_at(8));
+  // The pulse was given (and refused for its reason, under pulse.), the others not at all.
+  EXPECT_EQ(pulses.counts().rejected("pulse.no_beacon_map"), 1u);
+  EXPECT_EQ(pulses.counts().rejected_by_reason().size(), 1u);
+
+  LocalizerCore ranges("range_ekf", config);
+  ranges.on_odometry("r", odometry_at(0));
+  ranges.on_pulse("r", before_sync);
+  EXPECT_TRUE(ranges.counts().rejected_by_reason().empty());
+}
+
+// What an estimator holds beside the pose goes out with a pose once a second of data time, and
+// only from estimators that have such state.
+TEST(EstimatorInput, TheEstimatorStateGoesOutOnceASecondWithAPose) {
+  const sim::Scenario s = sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/seed002_kleeman.yaml");
+  EstimatorConfig config;
+  config.receivers = s.receivers;
+  LocalizerCore core("kleeman_iekf", config);
+  core.set_beacon_map(BeaconMap(s.beacons));
+  std::vector<StampNs> state_stamps;
+  for (const SourceEvent& e : simulate(s, 1, 10.0)) {
+    std::optional<LocalizerOutput> out;
+    if (e.kind == SourceEvent::Kind::kOdometry) out = core.on_odometry("r", e.odometry);
+    if (e.kind == SourceEvent::Kind::kPulse) out = core.on_pulse("r", e.pulse);
+    if (!out || out->state.empty()) continue;
+    state_stamps.push_back(out->estimate.stamp_ns);
+    EXPECT_EQ(out->state.front().name, "speed_of_sound_mps");
+    EXPECT_GT(out->state.front().sigma, 0.0);
+  }
+  ASSERT_GE(state_stamps.size(), 7u);  // from the first fix at ~2 s
+  for (std::size_t i = 1; i < state_stamps.size(); ++i) {
+    EXPECT_GE(state_stamps[i] - state_stamps[i - 1], kEstimatorStatePeriodNs);
+    EXPECT_LT(state_stamps[i] - state_stamps[i - 1], kEstimatorStatePeriodNs + 20'000'000);
+  }
+  LocalizerCore ranges("range_ekf", config);
+  ranges.set_beacon_map(BeaconMap(s.beacons));
+  for (const SourceEvent& e : simulate(s, 1, 3.0)) {
+    if (e.kind != SourceEvent::Kind::kOdometry) continue;
+    if (auto out = ranges.on_odometry("r", e.odometry)) {
+      EXPECT_TRUE(out->state.empty());
+    }
+  }
+}
+
+// A robot whose pulses missed their deadline is degraded; the next pulse makes it ok again, as a
+// range does for the estimators of ranges.
+TEST(EstimatorInput, APulseAfterAMissedDeadlineEndsTheSilence) {
+  const sim::Scenario s = sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/seed002_kleeman.yaml");
+  sim::Scenario moving = s;
+  moving.trajectory = sim::Trajectory(Pose2(1.5, 1.5, 0.0), {{30.0, 0.25, 0.0}}, false);
+  EstimatorConfig config;
+  config.receivers = s.receivers;
+  LocalizerCore core("kleeman_iekf", config);
+  core.set_beacon_map(BeaconMap(s.beacons));
+  bool silenced = false;
+  std::optional<PoseStatus> after;
+  for (const SourceEvent& e : simulate(moving, 1, 12.0)) {
+    if (e.kind == SourceEvent::Kind::kOdometry) {
+      if (auto out = core.on_odometry("r", e.odometry); out && silenced) after = out->estimate.status;
+    }
+    if (e.kind != SourceEvent::Kind::kPulse) continue;
+    if (!silenced && ns_to_s(e.stamp_ns) > 8.0) {
+      core.on_ranges_silent("r");
+      ASSERT_EQ(core.worst_status(), PoseStatus::kDegraded);
+      silenced = true;
+      continue;
+    }
+    core.on_pulse("r", e.pulse);
+  }
+  ASSERT_TRUE(after);
+  EXPECT_EQ(*after, PoseStatus::kOk);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "beaconloc/core/models/range_model.hpp"
 #include "beaconloc/core/models/stacked_model.hpp"
 #include "beaconloc/core/models/velocity_motion.hpp"
+#include "kleeman_iekf/slot_transition.hpp"
 
 namespace beaconloc {
 namespace {
@@ -265,6 +266,31 @@ TEST(VelocityMotion, JacobiansMatchNumericOnArcsAndStraightLines) {
                                 1e-7, 1e-3);
   // Input noise: eq. 6 floored.
   EXPECT_EQ(motion.input_noise(Eigen::Vector2d(0.0, 0.0)), VelocityMotion::kMinVariance * Eigen::Matrix2d::Identity());
+}
+
+// Seed 002 eq. 15-16 (with the slot's mean heading, slot_transition.hpp) on its 7-number state.
+TEST(KleemanSlotTransition, JacobiansMatchNumericAndAreEquation16WithoutATurn) {
+  const kleeman::SlotTransition motion(1e-4, kleeman::SlotNoise{});
+  Vec<7> x;
+  x << 3.0, 4.0, 0.25, 2.5, 0.15, 12.0, 346.0;
+  const StateSpace<7> space = kleeman::state_space();
+  expect_motion_jacobians_match(motion, space, x, Vec<1>(0.07), 0.15, 1e-8);
+  expect_motion_jacobians_match(motion, space, x, Vec<1>(0.0), 0.15, 1e-8);
+  const auto lin = motion.linearize(x, Vec<1>(0.0), 0.15);
+  Mat<7, 7> eq16 = Mat<7, 7>::Identity();
+  const double v = 0.25, period = 0.15, c = std::cos(2.5), s = std::sin(2.5);
+  eq16(0, 2) = period * c;
+  eq16(0, 3) = -period * v * s;
+  eq16(0, 4) = v * c;
+  eq16(1, 2) = period * s;
+  eq16(1, 3) = period * v * c;
+  eq16(1, 4) = v * s;
+  eq16(5, 4) = 1.0;
+  EXPECT_TRUE(lin.jacobian_state.isApprox(eq16, 1e-15));
+  EXPECT_DOUBLE_EQ(lin.step(5), period);  // t0(k+1) = t0(k) + T(k)
+  // Travel by an unknown direction goes on x and y as noise.
+  const Mat<7, 7> q = kleeman::SlotTransition(1e-4, kleeman::SlotNoise{}, 0.01).state_noise<7>(7, 0.15);
+  EXPECT_DOUBLE_EQ(q(0, 0), kleeman::SlotNoise{}.position_m * kleeman::SlotNoise{}.position_m + 0.01);
 }
 
 }  // namespace

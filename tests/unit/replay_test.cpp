@@ -69,6 +69,34 @@ TEST(Replay, RowsConvertExactly) {
   EXPECT_NEAR(w, 0.1, 1e-12);
 }
 
+// Beacons without a radio message (seed 002): pulses.csv instead of ranges.csv, each row a pulse
+// arrival with its double-burst mark; a mark that is none of the three is refused by name.
+TEST(Replay, PulseArrivalsReplayWithTheirMarkAndABadMarkIsRefused) {
+  const std::string dir = ::testing::TempDir() + "/replay_pulses";
+  std::filesystem::remove_all(dir);  // a previous run's files
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/beacons.csv") << "beacon_id,x_m,y_m,z_m\n1,1,2,3\n2,4,2,3\n";
+  std::ofstream(dir + "/odom.csv") << "t_s,dt_s,v_mps,omega_radps\n10.0,0.2,0.8,0.1\n";
+  std::ofstream(dir + "/pulses.csv") << "t_s,mark\n10.05,double\n10.2,single\n10.35,not_reported\n10.5,triple\n";
+  ReplaySource replay(dir);
+  EXPECT_EQ(replay.beacon_input(), BeaconInput::kPulseArrivals);
+  std::vector<PulseMark> marks;
+  for (const auto& e : everything(replay)) {
+    if (e.kind != SourceEvent::Kind::kPulse) continue;
+    EXPECT_EQ(e.pulse.stamp_ns, e.stamp_ns);
+    EXPECT_EQ(e.pulse.receiver_id, 0u);
+    marks.push_back(e.pulse.mark);
+  }
+  EXPECT_EQ(marks, (std::vector<PulseMark>{PulseMark::kDouble, PulseMark::kSingle, PulseMark::kNotReported}));
+  EXPECT_EQ(replay.load_counts().rejected("pulses.invalid_mark"), 1u);
+  // One way of hearing the beacons per recording.
+  std::ofstream(dir + "/ranges.csv") << "t_s,beacon_id,range_m\n10.1,1,2.5\n";
+  EXPECT_THROW(ReplaySource{dir}, ReplayError);
+  // A recording of ranges is what it always was.
+  std::filesystem::remove(dir + "/pulses.csv");
+  EXPECT_EQ(ReplaySource(dir).beacon_input(), BeaconInput::kRawTof);
+}
+
 TEST(Replay, BadRowsAreRefusedAndCountedNotRepaired) {
   const std::string dir = ::testing::TempDir() + "/replay_bad";
   std::filesystem::create_directories(dir);

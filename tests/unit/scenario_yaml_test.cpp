@@ -66,6 +66,8 @@ TEST(ScenarioYaml, MinimalFileUsesTheDocumentedDefaults) {
   EXPECT_EQ(s.slot_period_ns, 200 * kNsPerMillisecond);
   EXPECT_DOUBLE_EQ(s.range_sigma_m, 0.01);
   EXPECT_TRUE(s.identified);
+  EXPECT_TRUE(s.radio_sync);
+  EXPECT_EQ(s.score_from_s, 0.0);
   EXPECT_EQ(s.firing_order, std::vector<std::uint32_t>{1});
   EXPECT_FALSE(s.map);
   EXPECT_NEAR(s.trajectory.period_s(), 2.0, 1e-12);
@@ -96,6 +98,11 @@ TEST(ScenarioYaml, ErrorsNameTheKeyAndLine) {
             std::string::npos);
   EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {firing_order: [7]}\n").find("names beacon 7"),
             std::string::npos);
+  // A pulse without a radio message carries no id either.
+  EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {radio_sync: false}\n")
+                .find("'beacon_system.radio_sync' false needs identified: false"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kMinimal) + "score_from_s: -1\n").find("'score_from_s' must be in"), std::string::npos);
   EXPECT_NE(error_of("name: t\n").find("'beacons' is required"), std::string::npos);
   EXPECT_NE(error_of(std::string(kMinimal) + "laser: {beams: 3}\n").find("needs a map"), std::string::npos);
   EXPECT_NE(error_of("name: [unclosed\n").find("not valid YAML"), std::string::npos);

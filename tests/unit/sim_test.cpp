@@ -127,5 +127,31 @@ TEST(SimSource, OdometryNoiseFollowsTheSpeedProportionalModel) {
   EXPECT_NEAR(sum_sq / n, expected, 0.05 * expected);
 }
 
+// Beacons without a radio message (seed 002): pulse arrivals only, at the arrival the time of
+// flight gives, the marked beacon's as double bursts and every other as single.
+TEST(SimSource, WithoutRadioSyncTheReceiverHearsPulseArrivalsMarkedByTheDoubleBurst) {
+  Scenario s = default_scenario();
+  const auto tofs = run(s, 3, 4.0);
+  s.identified = false;
+  s.radio_sync = false;
+  s.marked_beacon_id = s.firing_order.front();
+  SimSource source(s, 3);
+  EXPECT_EQ(source.beacon_input(), BeaconInput::kPulseArrivals);
+  const auto pulses = run(s, 3, 4.0);
+  ASSERT_EQ(tofs.size(), pulses.size());
+  std::size_t doubles = 0;
+  for (std::size_t i = 0; i < tofs.size(); ++i) {
+    EXPECT_NE(pulses[i].kind, SourceEvent::Kind::kTof);
+    if (tofs[i].kind != SourceEvent::Kind::kTof) continue;
+    ASSERT_EQ(pulses[i].kind, SourceEvent::Kind::kPulse);
+    EXPECT_EQ(pulses[i].pulse.stamp_ns, tofs[i].tof.fire_stamp_ns + s_to_ns(tofs[i].tof.tof_s));
+    EXPECT_EQ(pulses[i].pulse.receiver_id, tofs[i].tof.receiver_id);
+    const bool marked = pulses[i].true_beacon_id == *s.marked_beacon_id;
+    EXPECT_EQ(pulses[i].pulse.mark, marked ? PulseMark::kDouble : PulseMark::kSingle);
+    doubles += marked;
+  }
+  EXPECT_GT(doubles, 0u);
+}
+
 }  // namespace
 }  // namespace beaconloc::sim

@@ -64,8 +64,9 @@ class AccuracyCommand : public Command {
         ->transform(real_in(0.0, 1.0));
     app_->add_option("--table", table_,
                      "pose: E_p, E_phi, E_S, NEES (seed 000 Table II); distance: mean, std, RMSE, max of the "
-                     "position error and the association rates (seed 001 Tables 4-7)")
-        ->check(CLI::IsMember({"pose", "distance"}));
+                     "position error and the association rates (seed 001 Tables 4-7); path: the path error's std and "
+                     "max (seed 002 Sec. 4)")
+        ->check(CLI::IsMember({"pose", "distance", "path"}));
     app_->add_option("--out", out_file_, "also write the table to this file");
     app_->add_option("--fault", faults_,
                      "also score the scenarios with this fault (repeatable, all at once): beacon_dies=ID@T, "
@@ -88,7 +89,9 @@ class AccuracyCommand : public Command {
         }
       }
     }
-    const std::string table = table_ == "distance" ? distance_table_markdown(rows) : accuracy_table_markdown(rows);
+    const std::string table = table_ == "distance" ? distance_table_markdown(rows)
+                              : table_ == "path"   ? path_table_markdown(rows)
+                                                   : accuracy_table_markdown(rows);
     // The file first: a reader of stdout that leaves early (`| head`) ends the command (SIGPIPE).
     if (!out_file_.empty()) {
       std::ofstream out(out_file_);

@@ -33,8 +33,10 @@ class PipelineCommand : public Command {
     const bool has_truth = r.truth_samples > 0;
     std::printf("poses: %zu at %.1f Hz; %s\n", r.poses, r.pose_rate_hz,
                 has_truth ? format_metrics(r.metrics).c_str() : "no ground truth: not scored");
-    if (!o.out_dir.empty())
-      std::cout << "wrote " << o.out_dir << "/{truth,estimate,beacons}.csv, metrics.json, trajectory.svg, error.svg\n";
+    if (!o.out_dir.empty()) {
+      std::cout << "wrote " << o.out_dir << "/{truth,estimate,beacons}.csv, metrics.json, trajectory.svg, error.svg"
+                << (r.estimator_state_rows ? ", estimator_state.csv" : "") << '\n';
+    }
     if (r.poses == 0) {
       std::cerr << "beaconloc: no pose was estimated (the localizer's last status is above)\n";
       return 1;

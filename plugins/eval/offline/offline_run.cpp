@@ -49,15 +49,19 @@ OfflineStack::OfflineStack(const sim::Scenario& scenario, const std::string& est
 }
 
 std::optional<EstimatorInput> estimator_input(const std::string& robot_id, const SourceEvent& e,
-                                              TofDecoder& decoder, bool raw_tof) {
+                                              TofDecoder& decoder, BeaconInput beacon_input) {
   switch (e.kind) {
     case SourceEvent::Kind::kOdometry:
       return e.odometry;
     case SourceEvent::Kind::kLaserScan:
       return e.scan;
     case SourceEvent::Kind::kTof:
-      if (raw_tof) return e.tof;
+      if (beacon_input == BeaconInput::kRawTof) return e.tof;
+      if (beacon_input != BeaconInput::kRanges) return std::nullopt;
       if (auto out = decoder.decode(robot_id, e.tof); out.range) return out.range->range;
+      return std::nullopt;
+    case SourceEvent::Kind::kPulse:
+      if (beacon_input == BeaconInput::kPulseArrivals) return e.pulse;
       return std::nullopt;
     case SourceEvent::Kind::kTruth:
       return std::nullopt;
@@ -66,7 +70,7 @@ std::optional<EstimatorInput> estimator_input(const std::string& robot_id, const
 }
 
 std::optional<LocalizerOutput> OfflineStack::feed(const std::string& robot_id, const SourceEvent& e) {
-  std::optional<EstimatorInput> input = estimator_input(robot_id, e, decoder, localizer.uses_raw_tof());
+  std::optional<EstimatorInput> input = estimator_input(robot_id, e, decoder, localizer.beacon_input());
   if (!input) return std::nullopt;
   if (const auto* range = std::get_if<RangeMeasurement>(&*input); range && e.true_beacon_id != kBeaconUnidentified) {
     range_truth_[range->stamp_ns] = e.true_beacon_id;
@@ -112,7 +116,8 @@ std::vector<SourceEvent> deliver(std::vector<SourceEvent> events, const Delivery
   arrival.reserve(events.size());
   for (std::size_t i = 0; i < events.size(); ++i) {
     const bool measurement =
-        events[i].kind == SourceEvent::Kind::kTof || events[i].kind == SourceEvent::Kind::kLaserScan;
+        events[i].kind == SourceEvent::Kind::kTof || events[i].kind == SourceEvent::Kind::kPulse ||
+        events[i].kind == SourceEvent::Kind::kLaserScan;
     arrival.emplace_back(events[i].stamp_ns + (measurement ? delay_ns(rng) : 0), i);
   }
   std::stable_sort(arrival.begin(), arrival.end(),
@@ -141,7 +146,9 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
   result.rejections.add_rejections(stack.localizer.counts(), "localizer.");
   result.replays = stack.localizer.replays();
   EvaluationOptions options;
-  if (!rows.empty()) options.score_from_ns = rows.front().estimate.stamp_ns + s_to_ns(settle_s);
+  if (!rows.empty()) {
+    options.score_from_ns = std::max(rows.front().estimate.stamp_ns + s_to_ns(settle_s), s_to_ns(scenario.score_from_s));
+  }
   result.metrics = evaluate(truth, rows, options);
   return result;
 }
@@ -224,6 +231,29 @@ std::string distance_table_markdown(const std::vector<AccuracyRow>& rows) {
     };
     for (auto id : beacon_ids) out << ' ' << rate(id) << " |";
     out << ' ' << rate(std::nullopt) << " |\n";
+  }
+  return out.str();
+}
+
+std::string path_table_markdown(const std::vector<AccuracyRow>& rows) {
+  std::ostringstream out;
+  out << "| scenario | estimator | seeds | path error std (m) | path error max (m) | largest max (m) | E_p RMS (m) | "
+         "E_phi RMS (deg) | NEES in band |\n"
+      << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& row : rows) {
+    std::vector<double> sd, max, ep, ephi, nees;
+    for (const auto& m : row.runs) {
+      if (m.path_error_std_m) sd.push_back(*m.path_error_std_m);
+      if (m.path_error_max_m) max.push_back(*m.path_error_max_m);
+      ep.push_back(m.position_rms_m);
+      if (m.heading_rms_deg) ephi.push_back(*m.heading_rms_deg);
+      nees.push_back(m.nees_in_band_fraction);
+    }
+    char largest[32] = "n/a";
+    if (!max.empty()) std::snprintf(largest, sizeof largest, "%.4f", *std::max_element(max.begin(), max.end()));
+    out << "| " << row.scenario << " | " << row.estimator << " | " << row.runs.size() << " | "
+        << mean_and_spread(sd, 4) << " | " << mean_and_spread(max, 4) << " | " << largest << " | "
+        << mean_and_spread(ep, 4) << " | " << mean_and_spread(ephi, 2) << " | " << mean_and_spread(nees, 2) << " |\n";
   }
   return out.str();
 }

@@ -20,11 +20,12 @@ namespace beaconloc {
 std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed, double duration_s);
 
 // What the localizer is given for a source event, as the participants deliver it: odometry and
-// scans as they are; a TOF decoded into a range by `decoder` (nullopt when the decoder refuses
-// it), or the TOF itself for an estimator that uses raw times of flight (raw_tof); nullopt for a
-// truth event.
+// scans as they are; for an estimator of ranges a TOF decoded into a range by `decoder` (nullopt
+// when the decoder refuses it), for one of raw times of flight the TOF itself, for one of pulse
+// arrivals the pulse (beacon_input); nullopt for a truth event and for a beacon measurement the
+// estimator does not take (the participant does not subscribe to it).
 std::optional<EstimatorInput> estimator_input(const std::string& robot_id, const SourceEvent& e,
-                                              TofDecoder& decoder, bool raw_tof);
+                                              TofDecoder& decoder, BeaconInput beacon_input);
 
 // Anonymous ranges associated with a beacon by the estimator, scored against the simulator's
 // truth (who fired), per true beacon.
@@ -96,5 +97,9 @@ std::string accuracy_table_markdown(const std::vector<AccuracyRow>& rows);
 // Seed 001 Tables 4-7: mean, standard deviation, RMS and maximum of the distance error, and the
 // rate of correct association per beacon and overall, each as mean +- spread over the seeds.
 std::string distance_table_markdown(const std::vector<AccuracyRow>& rows);
+
+// Seed 002 Sec. 4: the path error's standard deviation and maximum (Metrics::path_error_*), mean
+// +- spread over the seeds and the largest of any seed, beside E_p, E_phi and NEES in band.
+std::string path_table_markdown(const std::vector<AccuracyRow>& rows);
 
 }  // namespace beaconloc

@@ -56,7 +56,16 @@ ReplaySource::ReplaySource(const std::string& directory, ReplayOptions options)
     throw ReplayError("replay wheel base must be in (0, " + std::to_string(kMaxWheelBaseM) + "] m");
   load_beacons(directory + "/beacons.csv");
   load_odometry(directory + "/odom.csv");
-  load_ranges(directory + "/ranges.csv");
+  // A recording hears its beacons one way: ranges, or pulse arrivals without a firing time.
+  const bool has_pulses = static_cast<bool>(std::ifstream(directory + "/pulses.csv"));
+  if (has_pulses && std::ifstream(directory + "/ranges.csv")) {
+    throw ReplayError(directory + ": both ranges.csv and pulses.csv; a recording has one or the other");
+  }
+  if (has_pulses) {
+    load_pulses(directory + "/pulses.csv");
+  } else {
+    load_ranges(directory + "/ranges.csv");
+  }
   load_truth(directory + "/gt.csv");
   // Merge the files by stamp; within a file, order is kept (stable).
   std::stable_sort(events_.begin(), events_.end(),
@@ -193,6 +202,42 @@ void ReplaySource::load_ranges(const std::string& path) {
     e.tof.fire_stamp_ns = arrival_ns - s_to_ns(e.tof.tof_s);
     e.tof.beacon_temperature_c = options_.reference_temperature_c;
     e.tof.sequence_number = sequence++;
+    events_.push_back(e);
+  }
+}
+
+void ReplaySource::load_pulses(const std::string& path) {
+  beacon_input_ = BeaconInput::kPulseArrivals;
+  CsvReader csv = open(path, {"t_s", "mark"});
+  StampNs previous = std::numeric_limits<StampNs>::min();
+  std::uint64_t sequence = 0;
+  while (csv.next()) {
+    double t = 0;
+    if (!complete(csv, "pulses") || !take(csv, "pulses", "t_s", t, 0.0, kMaxFileStampS)) continue;
+    const std::string mark = csv.cell("mark");
+    PulseMark parsed = PulseMark::kNotReported;
+    if (mark == to_string(PulseMark::kSingle)) {
+      parsed = PulseMark::kSingle;
+    } else if (mark == to_string(PulseMark::kDouble)) {
+      parsed = PulseMark::kDouble;
+    } else if (mark != to_string(PulseMark::kNotReported)) {
+      refuse("pulses", csv.line(), "invalid_mark", "mark '" + mark + "' is not single, double or not_reported");
+      continue;
+    }
+    const StampNs arrival_ns = s_to_ns(t);
+    if (arrival_ns < previous && notes_.size() < 20) {
+      notes_.push_back(directory_ + "/pulses.csv:" + std::to_string(csv.line()) + ": " +
+                       std::to_string(ns_to_s(previous - arrival_ns)) +
+                       " s earlier than the row before; pulses are replayed in stamp order");
+    }
+    previous = std::max(previous, arrival_ns);
+    SourceEvent e;
+    e.kind = SourceEvent::Kind::kPulse;
+    e.stamp_ns = arrival_ns;
+    e.pulse.stamp_ns = arrival_ns;
+    e.pulse.receiver_id = 0;  // one receiver at the robot's centre (receivers())
+    e.pulse.mark = parsed;
+    e.pulse.sequence_number = sequence++;
     events_.push_back(e);
   }
 }

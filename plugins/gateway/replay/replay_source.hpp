@@ -1,7 +1,8 @@
 #pragma once
 // Replays a recording in the common CSV layout of ../shared/datasets/*/replay/ (documented in
 // docs/replay-format.md): odom.csv (t_s, dt_s, v_mps, omega_radps), ranges.csv (t_s, beacon_id,
-// range_m), beacons.csv (beacon_id, x_m, y_m, z_m), optional gt.csv (t_s, x_m, y_m[, yaw_rad]).
+// range_m), beacons.csv (beacon_id, x_m, y_m, z_m), optional gt.csv (t_s, x_m, y_m[, yaw_rad]);
+// from beacons without a radio message (seed 002), pulses.csv (t_s, mark) instead of ranges.csv.
 // Extra columns are allowed and ignored. A malformed, out-of-range, duplicate or out-of-order row
 // is skipped and counted by reason (reported with its file and line): "<file>.malformed_row" (a
 // cell short, a cell not a decimal number), "<file>.invalid_<column>" (a number outside its
@@ -49,6 +50,7 @@ class ReplaySource final : public Source {
   StampNs last_stamp_ns() const override { return events_.empty() ? 0 : events_.back().stamp_ns; }
   bool relative_stamps() const override { return false; }
   std::string describe() const override { return "replay " + directory_; }
+  BeaconInput beacon_input() const override { return beacon_input_; }
   RejectionCounter input_rejections() const override { return load_counts_; }
 
   // Rows refused while loading, by reason (e.g. "odom.malformed_row"), and the first problems
@@ -64,6 +66,7 @@ class ReplaySource final : public Source {
   void load_beacons(const std::string& path);
   void load_odometry(const std::string& path);
   void load_ranges(const std::string& path);
+  void load_pulses(const std::string& path);
   void load_truth(const std::string& path);
   static CsvReader open(const std::string& path, const std::vector<std::string>& columns);
   // The current row has every cell; else refused as <file>.malformed_row.
@@ -81,6 +84,7 @@ class ReplaySource final : public Source {
   std::vector<SourceEvent> events_;
   std::size_t next_ = 0;
   bool truth_has_yaw_ = false;
+  BeaconInput beacon_input_ = BeaconInput::kRawTof;
   RejectionCounter load_counts_;
   std::vector<std::string> problems_;
   std::vector<std::string> notes_;

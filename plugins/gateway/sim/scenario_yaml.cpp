@@ -158,7 +158,7 @@ void read_beacon_system(const Section& root, Scenario& sc) {
   for (const auto& b : sc.beacons) sc.firing_order.push_back(b.id);
   if (!root.has("beacon_system")) return;
   const Section s = root.child(
-      "beacon_system", {"slot_period_s", "first_slot_s", "firing_order", "identified", "marked_beacon_id",
+      "beacon_system", {"slot_period_s", "first_slot_s", "firing_order", "identified", "radio_sync", "marked_beacon_id",
                         "range_sigma_m", "tof_sigma_s", "min_range_m", "max_range_m", "beam_half_angle_deg",
                         "temperature_c", "reported_temperature_c", "echo"});
   sc.slot_period_ns = duration_ns(s, "slot_period_s", 0.2);
@@ -175,6 +175,10 @@ void read_beacon_system(const Section& root, Scenario& sc) {
     }
   }
   sc.identified = s.get<bool>("identified", true);
+  sc.radio_sync = s.get<bool>("radio_sync", true);
+  if (!sc.radio_sync && sc.identified)
+    s.fail(s.join("radio_sync"), "false needs identified: false (a pulse without a radio message carries no id)",
+           s.node("radio_sync"));
   if (s.has("marked_beacon_id")) sc.marked_beacon_id = s.get<std::uint32_t>("marked_beacon_id", 0);
   sc.range_sigma_m = s.number("range_sigma_m", 0.01, 0.0, 100.0);
   sc.tof_sigma_s = s.number("tof_sigma_s", 0.0, 0.0, 1.0);
@@ -356,13 +360,14 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
     throw ScenarioError(e.what());
   }
   const Section root(doc, "", origin,
-                     {"name", "description", "seed", "duration_s", "beacons", "beacon_system", "robot",
-                      "trajectory", "map", "laser"});
+                     {"name", "description", "seed", "duration_s", "score_from_s", "beacons", "beacon_system",
+                      "robot", "trajectory", "map", "laser"});
   Scenario sc;
   sc.name = root.required<std::string>("name");
   sc.description = root.get<std::string>("description", "");
   sc.seed = root.get<std::uint64_t>("seed", 1);
   sc.duration_s = root.number("duration_s", 20.0, 0.01, kMaxDurationS);
+  sc.score_from_s = root.number("score_from_s", 0.0, 0.0, sc.duration_s);
   read_beacons(root, sc);
   read_beacon_system(root, sc);
   read_robot(root, sc);

@@ -29,6 +29,19 @@ bool hears(const Scenario& s, const Eigen::Vector3d& beacon, const Eigen::Vector
   return cos_off_axis >= std::cos(s.beam_half_angle_rad) - 1e-12;
 }
 
+// What a receiver without the beacons' radio message reports of a pulse (seed 002 Sec. 2): when it
+// arrived, in the robot's clock (the simulator's), and whether it came as a double burst.
+static SourceEvent as_pulse_arrival(SourceEvent tof, std::optional<std::uint32_t> marked_beacon_id) {
+  SourceEvent e = std::move(tof);
+  e.kind = SourceEvent::Kind::kPulse;
+  e.pulse.stamp_ns = e.stamp_ns;
+  e.pulse.receiver_id = e.tof.receiver_id;
+  e.pulse.mark = marked_beacon_id && *marked_beacon_id == e.true_beacon_id ? PulseMark::kDouble : PulseMark::kSingle;
+  e.pulse.sequence_number = e.tof.sequence_number;
+  e.tof = RawTofSample{};
+  return e;
+}
+
 SimSource::SimSource(Scenario scenario, std::uint64_t seed)
     : scenario_(std::move(scenario)),
       rng_(seed),
@@ -80,6 +93,7 @@ void SimSource::fire(StampNs fire_ns) {
       --tof_sequence_;
       continue;
     }
+    if (!scenario_.radio_sync) e = as_pulse_arrival(std::move(e), scenario_.marked_beacon_id);
     pending_tofs_.push(e);
   }
 }

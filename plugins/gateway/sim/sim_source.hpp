@@ -26,6 +26,9 @@ class SimSource final : public Source {
   StampNs last_stamp_ns() const override { return s_to_ns(scenario_.duration_s); }
   bool relative_stamps() const override { return true; }
   std::string describe() const override { return "scenario " + scenario_.name; }
+  BeaconInput beacon_input() const override {
+    return scenario_.radio_sync ? BeaconInput::kRawTof : BeaconInput::kPulseArrivals;
+  }
   const Scenario& scenario() const { return scenario_; }
 
  private:

@@ -28,9 +28,21 @@ const char* to_string(PoseStatus s) {
 }
 
 const char* kind_name(const EstimatorInput& input) {
-  constexpr const char* kNames[] = {"odometry", "range", "laser", "raw_tof"};
+  constexpr const char* kNames[] = {"odometry", "range", "laser", "raw_tof", "pulse"};
   static_assert(std::variant_size_v<EstimatorInput> == std::size(kNames), "a name for every kind of input");
   return input.valueless_by_exception() ? "unknown" : kNames[input.index()];
+}
+
+bool is_beacon_input(const EstimatorInput& input, BeaconInput kind) {
+  switch (kind) {
+    case BeaconInput::kRanges:
+      return std::holds_alternative<RangeMeasurement>(input);
+    case BeaconInput::kRawTof:
+      return std::holds_alternative<RawTofSample>(input);
+    case BeaconInput::kPulseArrivals:
+      return std::holds_alternative<PulseArrivalSample>(input);
+  }
+  return false;
 }
 
 InputResult Estimator::push(const EstimatorInput& input) {
@@ -40,6 +52,7 @@ InputResult Estimator::push(const EstimatorInput& input) {
     InputResult operator()(const RangeMeasurement& r) const { return e.update(r); }
     InputResult operator()(const LaserScanSample& s) const { return e.update_laser(s); }
     InputResult operator()(const RawTofSample& t) const { return e.update_raw_tof(t); }
+    InputResult operator()(const PulseArrivalSample& p) const { return e.update_pulse(p); }
   };
   return std::visit(Dispatch{*this}, input);
 }
@@ -94,6 +107,8 @@ const char* to_string(StartupCondition c) {
       return "position_too_uncertain";
     case StartupCondition::kHeadingTooUncertain:
       return "heading_too_uncertain";
+    case StartupCondition::kNoDoubleBurst:
+      return "no_double_burst";
   }
   return "unknown";
 }
@@ -129,6 +144,9 @@ std::string StartupWait::describe() const {
       break;
     case StartupCondition::kHeadingTooUncertain:
       std::snprintf(text, sizeof text, "fix too uncertain: heading sigma %.2f rad > %.2f rad", value, limit);
+      break;
+    case StartupCondition::kNoDoubleBurst:
+      std::snprintf(text, sizeof text, "no double burst heard yet: the beacons cannot be named");
       break;
   }
   return note.empty() ? std::string(text) : std::string(text) + " (" + note + ")";

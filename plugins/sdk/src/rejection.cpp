@@ -30,6 +30,15 @@ const char* to_string(Rejection r) {
     case Rejection::kStaleScan: return "stale_scan";
     case Rejection::kLaserUnused: return "laser_unused";
     case Rejection::kRawTofUnused: return "raw_tof_unused";
+    case Rejection::kPulseUnused: return "pulse_unused";
+    case Rejection::kPulseBeforeDoubleBurst: return "pulse_before_double_burst";
+    case Rejection::kPulseBetweenSlots: return "pulse_between_slots";
+    case Rejection::kPulseLate: return "pulse_late";
+    case Rejection::kPulseTooFarAhead: return "pulse_too_far_ahead";
+    case Rejection::kStartupFitFailed: return "startup_fit_failed";
+    case Rejection::kDuplicatePulse: return "duplicate_pulse";
+    case Rejection::kTooManyPulsesInSlot: return "too_many_pulses_in_slot";
+    case Rejection::kBeaconMapUnusable: return "beacon_map_unusable";
     case Rejection::kTooLate: return "too_late";
     case Rejection::kAheadOfOdometry: return "ahead_of_odometry";
     case Rejection::kGatedNis: return "gated_nis";

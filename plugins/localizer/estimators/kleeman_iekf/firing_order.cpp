@@ -46,8 +46,19 @@ FiringOrder::Pulse FiringOrder::heard(std::int64_t slot, bool double_burst) {
   }
   if (double_burst) {
     const std::optional<std::uint32_t> expected = beacon_of(slot);
-    if (expected && *expected != order_[static_cast<std::size_t>(marked_index_)]) ++resynchronizations_;
-    sync_slot_ = slot;
+    if (!expected) {
+      sync_slot_ = slot;  // the first: it numbers the slots
+    } else if (*expected != order_[static_cast<std::size_t>(marked_index_)]) {
+      ++contradicting_double_bursts_;
+      const auto n = static_cast<std::int64_t>(order_.size());
+      if (contradicting_slot_ && slot != *contradicting_slot_ && (slot - *contradicting_slot_) % n == 0) {
+        sync_slot_ = slot;  // confirmed a cycle (or more) later: the numbering was off
+        ++resynchronizations_;
+        contradicting_slot_.reset();
+      } else {
+        contradicting_slot_ = slot;
+      }
+    }
   }
   if (last_heard_ && slot == *last_heard_) {
     ++extra_pulses_;

@@ -13,10 +13,12 @@
 
 namespace beaconloc::kleeman {
 
-// The most slots a pulse may lie ahead of the filter's current slot: two cycles of the six
-// beacons. A pulse further ahead means the filter's t0 or T is far off (or the pulse's stamp is),
-// and stepping the filter through that many slots would only spread its uncertainty.
-inline constexpr std::int64_t kMaxSlotsAhead = 12;
+// The most slots a pulse may lie ahead of the filter's current slot: 10 s of seed 002's 150 ms
+// slots, after which a pose without a correction is lost anyway (StalenessPolicy). Through a
+// shorter silence (an outage, a robot behind a pillar) the filter steps slot by slot on its dead
+// reckoning, its uncertainty growing as it should; a pulse further ahead means the filter's t0
+// or T is far off (or the pulse's stamp is), and the estimator starts again.
+inline constexpr std::int64_t kMaxSlotsAhead = 67;
 
 // Where a pulse heard at arrival_s falls against the slots t0_s + k period_s (k >= 0).
 struct PulseSlot {
@@ -47,9 +49,11 @@ class FiringOrder {
     kExtraInSlot,  // the slot was heard already: an echo, or a stray (the gate decides)
     kOutOfOrder,   // a slot before the latest one heard: dropped, the filter has moved past it
   };
-  // A pulse heard in `slot`, marked as a double burst or not. A double burst sets the numbering:
-  // the marked beacon fired in that slot (re-synchronized, and counted, when the numbering said
-  // otherwise).
+  // A pulse heard in `slot`, marked as a double burst or not. The first double burst sets the
+  // numbering: the marked beacon fired in that slot. A later one where the numbering has another
+  // beacon is counted (contradicting_double_bursts) but moves the numbering only when a second
+  // confirms it a whole number of cycles later (re-synchronized, counted): an echo 3 ms behind a
+  // single burst looks like a double burst (Fig. 2), and one such must not renumber every beacon.
   Pulse heard(std::int64_t slot, bool double_burst);
 
   // The beacon that fired in `slot`; nullopt before the first double burst.
@@ -60,7 +64,9 @@ class FiringOrder {
   std::uint64_t missed_slots() const { return missed_slots_; }
   std::uint64_t extra_pulses() const { return extra_pulses_; }
   std::uint64_t out_of_order_pulses() const { return out_of_order_pulses_; }
-  // Double bursts heard in a slot the numbering gave to another beacon.
+  // Double bursts heard in a slot the numbering gave to another beacon, and the times two of them
+  // a whole number of cycles apart moved the numbering.
+  std::uint64_t contradicting_double_bursts() const { return contradicting_double_bursts_; }
   std::uint64_t resynchronizations() const { return resynchronizations_; }
 
  private:
@@ -68,9 +74,11 @@ class FiringOrder {
   std::int64_t marked_index_ = 0;           // of the marked beacon in order_
   std::optional<std::int64_t> sync_slot_;   // the slot of the last double burst
   std::optional<std::int64_t> last_heard_;  // the latest slot a pulse was heard in
+  std::optional<std::int64_t> contradicting_slot_;  // the last double burst the numbering contradicted
   std::uint64_t missed_slots_ = 0;
   std::uint64_t extra_pulses_ = 0;
   std::uint64_t out_of_order_pulses_ = 0;
+  std::uint64_t contradicting_double_bursts_ = 0;
   std::uint64_t resynchronizations_ = 0;
 };
 

@@ -24,6 +24,16 @@ bool identifier(const std::string& s) {
   return printable(s) && s.find_first_of(",\"") == std::string::npos;
 }
 
+bool defined(msg::PulseMark m) {
+  switch (m) {
+    case msg::PULSE_MARK_NOT_REPORTED:
+    case msg::PULSE_MARK_SINGLE:
+    case msg::PULSE_MARK_DOUBLE:
+      return true;
+  }
+  return false;
+}
+
 bool defined(msg::RangeAssociation a) {
   switch (a) {
     case msg::RANGE_ASSOCIATION_BY_ID:
@@ -58,6 +68,8 @@ bool defined(msg::ParticipantStatus s) {
 
 bool well_formed(const msg::RawTof& m) { return identifier(m.robot_id()); }
 
+bool well_formed(const msg::PulseArrival& m) { return identifier(m.robot_id()) && defined(m.mark()); }
+
 bool well_formed(const msg::BeaconRange& m) { return identifier(m.robot_id()) && defined(m.association()); }
 
 bool well_formed(const msg::Odometry& m) { return identifier(m.robot_id()); }
@@ -66,6 +78,14 @@ bool well_formed(const msg::LaserScan& m) { return identifier(m.robot_id()); }
 
 bool well_formed(const msg::PoseEstimate& m) {
   return identifier(m.robot_id()) && identifier(m.estimator()) && defined(m.status());
+}
+
+bool well_formed(const msg::EstimatorState& m) {
+  if (!identifier(m.robot_id()) || !identifier(m.estimator())) return false;
+  for (const msg::EstimatorStateValue& v : m.values()) {
+    if (!identifier(v.name())) return false;
+  }
+  return true;
 }
 
 bool well_formed(const msg::InitialPose& m) { return identifier(m.robot_id()); }

@@ -25,6 +25,51 @@ msg::RawTof to_msg(const std::string& robot_id, const RawTofSample& s) {
   return m;
 }
 
+namespace {
+PulseMark from_msg(msg::PulseMark m) {
+  switch (m) {
+    case msg::PULSE_MARK_SINGLE:
+      return PulseMark::kSingle;
+    case msg::PULSE_MARK_DOUBLE:
+      return PulseMark::kDouble;
+    case msg::PULSE_MARK_NOT_REPORTED:
+      break;
+  }
+  return PulseMark::kNotReported;
+}
+
+msg::PulseMark to_msg(PulseMark m) {
+  switch (m) {
+    case PulseMark::kSingle:
+      return msg::PULSE_MARK_SINGLE;
+    case PulseMark::kDouble:
+      return msg::PULSE_MARK_DOUBLE;
+    case PulseMark::kNotReported:
+      break;
+  }
+  return msg::PULSE_MARK_NOT_REPORTED;
+}
+}  // namespace
+
+PulseArrivalSample from_msg(const msg::PulseArrival& m) {
+  PulseArrivalSample s;
+  s.stamp_ns = m.arrival_stamp_ns();
+  s.receiver_id = m.receiver_id();
+  s.mark = from_msg(m.mark());
+  s.sequence_number = m.sequence_number();
+  return s;
+}
+
+msg::PulseArrival to_msg(const std::string& robot_id, const PulseArrivalSample& s) {
+  msg::PulseArrival m;
+  m.robot_id(robot_id);
+  m.receiver_id(s.receiver_id);
+  m.arrival_stamp_ns(s.stamp_ns);
+  m.mark(to_msg(s.mark));
+  m.sequence_number(s.sequence_number);
+  return m;
+}
+
 OdometrySample from_msg(const msg::Odometry& m) {
   OdometrySample s;
   s.stamp_ns = m.stamp_ns();

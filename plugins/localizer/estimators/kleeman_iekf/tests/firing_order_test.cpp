@@ -105,15 +105,22 @@ TEST(FiringOrder, APulseForASlotAlreadyPassedIsDroppedAndCounted) {
   EXPECT_FALSE(order.synchronized());  // a late double burst does not number the slots
 }
 
-TEST(FiringOrder, ADoubleBurstWhereTheNumberingSaysAnotherBeaconResynchronizesAndIsCounted) {
+TEST(FiringOrder, DoubleBurstsWhereTheNumberingSaysAnotherBeaconResynchronizeOnlyWhenTwoAgree) {
   FiringOrder order({1, 2, 3, 4, 5, 6}, 1);
   order.heard(0, true);
-  order.heard(6, true);  // as the numbering says: not a resynchronization
+  order.heard(6, true);  // as the numbering says: not a contradiction
+  EXPECT_EQ(order.contradicting_double_bursts(), 0u);
+  order.heard(13, true);  // the numbering says beacon 2: an echo behind a single burst, or an error
+  EXPECT_EQ(order.contradicting_double_bursts(), 1u);
   EXPECT_EQ(order.resynchronizations(), 0u);
-  order.heard(13, true);  // the numbering said beacon 2: the slots were off by one
+  EXPECT_EQ(*order.beacon_of(13), 2u);  // one mark does not renumber every beacon
+  order.heard(17, true);                // another, out of phase with the first: still not
+  EXPECT_EQ(order.resynchronizations(), 0u);
+  order.heard(23, true);  // a cycle after the last: the slots were off by five
+  EXPECT_EQ(order.contradicting_double_bursts(), 3u);
   EXPECT_EQ(order.resynchronizations(), 1u);
-  EXPECT_EQ(*order.beacon_of(13), 1u);
-  EXPECT_EQ(*order.beacon_of(14), 2u);
+  EXPECT_EQ(*order.beacon_of(23), 1u);
+  EXPECT_EQ(*order.beacon_of(24), 2u);
 }
 
 TEST(FiringOrder, AnOrderThatCannotNumberTheSlotsIsRefused) {

@@ -80,6 +80,7 @@ enum class StartupCondition {
   kMirrorAmbiguous,       // beacons on one line: the mirror image fits as well (value: its chi-square margin)
   kPositionTooUncertain,  // the fix's position sigma (value, m) above the limit
   kHeadingTooUncertain,   // the fix's heading sigma (value, rad) above the limit
+  kNoDoubleBurst,         // pulses without ids: none heard yet from the beacon that marks the cycle
 };
 const char* to_string(StartupCondition c);
 
@@ -91,6 +92,15 @@ struct StartupWait {
   // "2 of 3 beacons heard", "fix too uncertain: position sigma 0.52 m > 0.30 m", ...
   std::string describe() const;
 };
+
+// How an estimator hears the beacons.
+enum class BeaconInput {
+  kRanges,         // the decoder's ranges (BeaconRange): the beacon's firing time is known (radio)
+  kRawTof,         // raw times of flight (RawTof): the firing time known, the range its own to work out
+  kPulseArrivals,  // pulse arrivals only (PulseArrival): no firing time, no id (seed 002)
+};
+// Whether `input` is a beacon measurement of that kind (false for odometry and laser scans).
+bool is_beacon_input(const EstimatorInput& input, BeaconInput kind);
 
 class Estimator {
  public:
@@ -113,12 +123,16 @@ class Estimator {
   virtual InputResult update_laser(const LaserScanSample& /*scan*/) {
     return InputResult::rejected(Rejection::kLaserUnused);
   }
-  // Raw times of flight, for the estimators that turn them into ranges themselves (they estimate
-  // the speed of sound, seed 002): the localizer subscribes to RawTof for those
-  // (uses_raw_tof()) and to the decoder's ranges for the others, which are never pushed one.
-  virtual bool uses_raw_tof() const { return false; }
+  // What the estimator hears the beacons as (BeaconInput): the localizer subscribes to that topic
+  // alone, and the estimator is never pushed the other kinds.
+  virtual BeaconInput beacon_input() const { return BeaconInput::kRanges; }
+  // Raw times of flight, for the estimators that turn them into ranges themselves.
   virtual InputResult update_raw_tof(const RawTofSample& /*tof*/) {
     return InputResult::rejected(Rejection::kRawTofUnused);
+  }
+  // Pulse arrivals with no firing time, for the estimators that track the beacons' cycle (seed 002).
+  virtual InputResult update_pulse(const PulseArrivalSample& /*pulse*/) {
+    return InputResult::rejected(Rejection::kPulseUnused);
   }
   // Anonymous ranges the estimator associated with a beacon since last asked (for evaluation
   // against the simulator's truth); empty for estimators that need identified ranges.
@@ -139,6 +153,15 @@ class Estimator {
   }
   // The current pose; nullopt until the estimator has one.
   virtual std::optional<PoseEstimate> estimate() const = 0;
+  // What it estimates beside the pose, named with their units (seed 002: the speed of sound, the
+  // beacons' cycle), each with its standard deviation, while it has a pose; empty for most. The
+  // localizer publishes them once a second of data time (EstimatorState), for plots and tuning.
+  struct StateValue {
+    std::string name;  // snake_case with its unit: "speed_of_sound_mps"
+    double value = 0.0;
+    double sigma = 0.0;
+  };
+  virtual std::vector<StateValue> state_values() const { return {}; }
   // Status from data time alone (the stamps pushed so far).
   virtual PoseStatus status() const = 0;
   // While estimate() is nullopt, the start-up condition the estimator waits for; nullopt once

@@ -46,6 +46,37 @@ struct RawTofSample {
 
 namespace beaconloc {
 
+// Whether a pulse came as beacon 1's double burst (seed 002 Fig. 2), where the receiver hardware
+// tells: an explicit third value, not a default that reads as "single".
+enum class PulseMark : std::uint8_t {
+  kNotReported,  // the hardware does not tell single from double bursts
+  kSingle,
+  kDouble,
+};
+
+// Stable names, as recordings write them ("not_reported", "single", "double").
+inline const char* to_string(PulseMark m) {
+  switch (m) {
+    case PulseMark::kSingle:
+      return "single";
+    case PulseMark::kDouble:
+      return "double";
+    case PulseMark::kNotReported:
+      break;
+  }
+  return "not_reported";
+}
+
+// DDS-free form of the PulseArrival topic: one receiver hearing an ultrasonic pulse from a
+// beacon that sends neither its id nor its firing time (seed 002 Sec. 2): the arrival time in the
+// receiver's clock, the robot's (the clock its odometry is stamped with), and nothing else.
+struct PulseArrivalSample {
+  StampNs stamp_ns = 0;  // arrival of the pulse (the start of its envelope)
+  std::uint32_t receiver_id = 0;
+  PulseMark mark = PulseMark::kNotReported;
+  std::uint64_t sequence_number = 0;
+};
+
 // DDS-free form of the LaserScan topic. Beam i points at angle_min_rad + i * angle_increment_rad
 // in the robot frame; a range outside [range_min_m, range_max_m] (e.g. +inf) is no return.
 struct LaserScanSample {

@@ -42,6 +42,16 @@ enum class Rejection : std::uint8_t {
   kStaleScan,
   kLaserUnused,
   kRawTofUnused,  // a raw time of flight, to an estimator of decoded ranges
+  // Pulse arrivals without a firing time (seed 002).
+  kPulseUnused,             // to an estimator that does not track the beacons' cycle
+  kPulseBeforeDoubleBurst,  // heard before the first double burst: no beacon can be named yet
+  kPulseBetweenSlots,       // later than the longest flight after any firing: not a direct pulse
+  kPulseLate,               // of a slot the filter has moved past
+  kPulseTooFarAhead,        // further ahead of the filter's cycle than it can step (kMaxSlotsAhead)
+  kStartupFitFailed,        // the start-up fit this pulse completed found no state that explains the pulses
+  kDuplicatePulse,          // a receiver's arrival stamp heard already
+  kTooManyPulsesInSlot,     // a flood: more pulses in one slot than echoes explain
+  kBeaconMapUnusable,       // no marked beacon, too few beacons, or slots that would be ambiguous
   // Out-of-sequence fusion (core/out_of_sequence_fusion.hpp).
   kTooLate,
   kAheadOfOdometry,

@@ -31,10 +31,12 @@ namespace beaconloc::dds {
 // True when every enumeration field of `m` holds a value its IDL type defines, no string field
 // holds a control character (C0, DEL, C1) and no name holds ',' or '"'.
 bool well_formed(const msg::RawTof& m);
+bool well_formed(const msg::PulseArrival& m);
 bool well_formed(const msg::BeaconRange& m);
 bool well_formed(const msg::Odometry& m);
 bool well_formed(const msg::LaserScan& m);
 bool well_formed(const msg::PoseEstimate& m);
+bool well_formed(const msg::EstimatorState& m);
 bool well_formed(const msg::InitialPose& m);
 bool well_formed(const msg::BeaconMap& m);
 bool well_formed(const msg::Diagnostics& m);

@@ -14,6 +14,9 @@ namespace beaconloc::dds {
 
 RawTofSample from_msg(const msg::RawTof& m);
 msg::RawTof to_msg(const std::string& robot_id, const RawTofSample& s);
+// A mark the IDL does not define never gets here (checked_type.hpp refuses the sample).
+PulseArrivalSample from_msg(const msg::PulseArrival& m);
+msg::PulseArrival to_msg(const std::string& robot_id, const PulseArrivalSample& s);
 
 OdometrySample from_msg(const msg::Odometry& m);
 msg::Odometry to_msg(const std::string& robot_id, const OdometrySample& s, std::uint64_t sequence);

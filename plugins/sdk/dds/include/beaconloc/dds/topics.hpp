@@ -9,12 +9,16 @@ struct TopicSpec {
 };
 
 inline constexpr TopicSpec kRawTofTopic{"beaconloc/raw_tof", "raw_tof.writer", "raw_tof.reader"};
+inline constexpr TopicSpec kPulseArrivalTopic{"beaconloc/pulse_arrival", "pulse_arrival.writer",
+                                              "pulse_arrival.reader"};
 inline constexpr TopicSpec kBeaconRangeTopic{"beaconloc/beacon_range", "beacon_range.writer",
                                              "beacon_range.reader"};
 inline constexpr TopicSpec kOdometryTopic{"beaconloc/odometry", "odometry.writer", "odometry.reader"};
 inline constexpr TopicSpec kLaserScanTopic{"beaconloc/laser_scan", "laser_scan.writer", "laser_scan.reader"};
 inline constexpr TopicSpec kPoseEstimateTopic{"beaconloc/pose_estimate", "pose_estimate.writer",
                                               "pose_estimate.reader"};
+inline constexpr TopicSpec kEstimatorStateTopic{"beaconloc/estimator_state", "estimator_state.writer",
+                                                "estimator_state.reader"};
 inline constexpr TopicSpec kInitialPoseTopic{"beaconloc/initial_pose", "initial_pose.writer",
                                              "initial_pose.reader"};
 inline constexpr TopicSpec kBeaconMapTopic{"beaconloc/beacon_map", "beacon_map.writer", "beacon_map.reader"};

@@ -1,0 +1,217 @@
+// kleeman_iekf on the seed 002 setup (examples/scenarios/seed002_kleeman.yaml) over ten seeds,
+// against the paper's Sec. 4 and the simulator's truth (release builds only: about 2 s there).
+// docs/accuracy-seed002.md has the figures and the commands that print them.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <Eigen/Cholesky>
+
+#include "beaconloc/core/speed_of_sound.hpp"
+#include "kleeman_iekf/kleeman_iekf.hpp"
+#include "offline_run.hpp"
+#include "sim/faults.hpp"
+#include "sim/scenario_yaml.hpp"
+
+namespace beaconloc {
+namespace {
+
+constexpr int kSeeds = 10;
+
+sim::Scenario seed002() {
+  return sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/seed002_kleeman.yaml");
+}
+
+double mean_of(const std::vector<double>& v) {
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  return sum / static_cast<double>(v.size());
+}
+
+struct Figures {
+  std::vector<double> path_std, path_max, position_rms, heading_rms, nees;
+};
+
+Figures over_seeds(const sim::Scenario& s, const std::vector<std::string>& params) {
+  Figures f;
+  for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    const OfflineRunResult r = run_scenario_offline(s, seed, "kleeman_iekf", params);
+    EXPECT_GT(r.metrics.samples, 10000u) << "seed " << seed;  // 112 s of 100 Hz poses scored
+    if (!r.metrics.path_error_std_m || !r.metrics.heading_rms_deg) {
+      ADD_FAILURE() << "seed " << seed << ": no path error";
+      continue;
+    }
+    f.path_std.push_back(*r.metrics.path_error_std_m);
+    f.path_max.push_back(*r.metrics.path_error_max_m);
+    f.position_rms.push_back(r.metrics.position_rms_m);
+    f.heading_rms.push_back(*r.metrics.heading_rms_deg);
+    f.nees.push_back(r.metrics.nees_in_band_fraction);
+  }
+  return f;
+}
+
+// Sec. 4: "a standard deviation in path error from 20 seconds until 120 seconds of 40 mm", "the
+// maximum error is limited to 100 mm". The path error's standard deviation meets the paper's; the
+// covariance is honest. Its maximum does NOT meet the paper's 100 mm (0.109 m on average, 0.145 m
+// at worst): the lateral error follows the heading error, and the heading random-walks with the
+// scenario's odometry noise (seed 000's k_v = 4e-4 m, an assumption: 0.011 rad a slot), which the
+// beacons' 7 cm a pulse correct slowly; with less odometry noise the maximum falls
+// (docs/accuracy-seed002.md, the k_v table). The 0.125 m below is a guard against regressions
+// at today's figure, not the paper's bound.
+TEST(KleemanOnSeed002, PathErrorMeetsThePapersStandardDeviationWithAnHonestCovariance) {
+  const Figures f = over_seeds(seed002(), {});
+  ASSERT_EQ(f.path_std.size(), static_cast<std::size_t>(kSeeds));
+  std::printf("seed 002, %d seeds: path error std %.4f m (paper 0.040), max %.4f m mean, %.4f m largest (paper 0.100), "
+              "E_p RMS %.4f m, E_phi RMS %.2f deg, NEES in band %.2f\n",
+              kSeeds, mean_of(f.path_std), mean_of(f.path_max), *std::max_element(f.path_max.begin(), f.path_max.end()),
+              mean_of(f.position_rms), mean_of(f.heading_rms), mean_of(f.nees));
+  EXPECT_LE(mean_of(f.path_std), 0.040);
+  EXPECT_LE(mean_of(f.path_max), 0.125);
+  EXPECT_GE(*std::min_element(f.nees.begin(), f.nees.end()), 0.80);
+}
+
+// The filter's state over a run, sampled at the odometry steps.
+struct Trace {
+  std::vector<double> t_s, speed_of_sound_mps, speed_of_sound_sigma_mps, cycle_s, fire_time_error_s;
+  std::size_t misnamed = 0;  // filter slots whose beacon is not the one that fired then
+  std::uint64_t losses = 0;
+};
+
+Trace trace(const sim::Scenario& s, std::uint64_t seed, const std::vector<std::string>& params) {
+  OfflineStack stack(s, "kleeman_iekf", parse_estimator_parameters(params, "param"));
+  Trace out;
+  for (const SourceEvent& e : simulate(s, seed, s.duration_s)) {
+    stack.feed("robot", e);
+    if (e.kind != SourceEvent::Kind::kOdometry) continue;
+    const auto* k = dynamic_cast<const KleemanIekf*>(stack.localizer.estimator("robot"));
+    if (!k || !k->filter_state()) continue;
+    const kleeman::State x = *k->filter_state();
+    const double fire_s = x(kleeman::kFireTime) + ns_to_s(*k->epoch_ns());
+    // The truth: the scenario fires slot k at first_slot + k T.
+    const double period = ns_to_s(s.slot_period_ns), first = ns_to_s(s.first_slot_ns);
+    out.t_s.push_back(ns_to_s(e.stamp_ns));
+    out.speed_of_sound_mps.push_back(x(kleeman::kSpeedOfSound));
+    out.speed_of_sound_sigma_mps.push_back(std::sqrt((*k->filter_covariance())(kleeman::kSpeedOfSound, kleeman::kSpeedOfSound)));
+    out.cycle_s.push_back(x(kleeman::kCycle));
+    const double firing = std::round((fire_s - first) / period);
+    out.fire_time_error_s.push_back(fire_s - (first + firing * period));
+    const auto fired = s.firing_order[static_cast<std::size_t>(firing) % s.firing_order.size()];
+    if (k->current_beacon() != fired) ++out.misnamed;
+    out.losses = k->losses();
+  }
+  return out;
+}
+
+// Sec. 4, Fig. 8: three initial speeds of sound (standard deviation 5 m/s) converge on one value.
+// Here from 5 m/s below and above the truth (26 C: 346.8 m/s) and from the nominal 20 C the
+// estimator assumes (343.3 m/s): at the end each lies within three of its own standard deviations
+// of the truth, the three within 0.5 m/s of one another. (How close to the truth they come is
+// what the geometry allows: the filter's own sigma, 0.6 m/s after 130 s here.)
+TEST(KleemanOnSeed002, TheSpeedOfSoundConvergesFromEitherSideAndFromTheNominalTemperature) {
+  const sim::Scenario s = seed002();
+  const double truth = speed_of_sound_mps(s.temperature_c);
+  std::vector<double> errors;
+  for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    std::vector<double> ends;
+    for (const double initial : {truth - 5.0, truth + 5.0, speed_of_sound_mps(20.0)}) {
+      const Trace t = trace(s, seed, {"initial_speed_of_sound_mps=" + std::to_string(initial)});
+      ASSERT_FALSE(t.t_s.empty());
+      const double end = t.speed_of_sound_mps.back(), sigma = t.speed_of_sound_sigma_mps.back();
+      EXPECT_LT(std::abs(end - truth), 3.0 * sigma) << "seed " << seed << " from " << initial;
+      EXPECT_LT(sigma, 1.0) << "seed " << seed;
+      ends.push_back(end);
+      errors.push_back(std::abs(end - truth));
+    }
+    EXPECT_LT(*std::max_element(ends.begin(), ends.end()) - *std::min_element(ends.begin(), ends.end()), 0.5)
+        << "seed " << seed;
+  }
+  std::printf("speed of sound after %.0f s, %d seeds x 3 starts: mean |error| %.2f m/s, largest %.2f m/s\n",
+              s.duration_s, kSeeds, mean_of(errors), *std::max_element(errors.begin(), errors.end()));
+}
+
+// How well the arrival times can tell the speed of sound at all: the Cramer-Rao bound on s over
+// the whole run's 880 firings with the robot's positions and the cycle known exactly, the firing
+// offset t0 (constant) and s the only unknowns, from the distances' spread over the beacons. Neither
+// the filter's own sigma nor its error can be below it; they are above, as the positions are
+// not known (the filter ends at about 0.6 m/s). So no estimator is within 0.5 m/s on every
+// seed here: the issue's 0.5 m/s is a third of a standard deviation from this bound's reach.
+TEST(KleemanOnSeed002, TheSpeedOfSoundIsKnownNoBetterThanTheGeometryAllows) {
+  const sim::Scenario s = seed002();
+  const double c = speed_of_sound_mps(s.temperature_c);
+  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();  // over (t0, s)
+  const double period = ns_to_s(s.slot_period_ns), first = ns_to_s(s.first_slot_ns);
+  for (std::size_t k = 0; first + period * static_cast<double>(k) < s.duration_s; ++k) {
+    const double fire_s = first + period * static_cast<double>(k);
+    const Pose2 p = s.trajectory.pose_at(fire_s);
+    const Eigen::Vector3d& b = BeaconMap(s.beacons).find(s.firing_order[k % s.firing_order.size()])->position_map_m;
+    const double d = Eigen::Vector3d(p.x() - b.x(), p.y() - b.y(), s.receivers.receiver_height_m - b.z()).norm();
+    const Eigen::Vector2d j(1.0, -d / (c * c));  // eq. 21's gradient in t0 and s
+    information += j * j.transpose() / (s.tof_sigma_s * s.tof_sigma_s);
+  }
+  const double bound = std::sqrt(information.ldlt().solve(Eigen::Matrix2d::Identity())(1, 1));
+  const Trace t = trace(s, 1, {});
+  ASSERT_FALSE(t.t_s.empty());
+  std::printf("speed of sound: bound with positions known %.3f m/s; the filter's sigma at the end %.3f m/s\n", bound,
+              t.speed_of_sound_sigma_mps.back());
+  EXPECT_GT(t.speed_of_sound_sigma_mps.back(), bound);
+}
+
+// T and t0 (eq. 14) converge, from a cycle 1.2 ms (1.2 of its prior sigmas) longer than the
+// nominal 150 ms the estimator assumes: T to 1.5 us of the truth and t0 to 0.3 ms (1.5 sigma of
+// one arrival) from 30 s on, and every slot's beacon named as the one that fired.
+TEST(KleemanOnSeed002, CycleTimeAndFiringTimeConvergeFromAnOffNominalCycle) {
+  sim::Scenario s = seed002();
+  s.slot_period_ns = 151'200'000;
+  for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    const Trace t = trace(s, seed, {});
+    double worst_cycle = 0.0, worst_fire = 0.0;
+    for (std::size_t i = 0; i < t.t_s.size(); ++i) {
+      if (t.t_s[i] < 30.0) continue;
+      worst_cycle = std::max(worst_cycle, std::abs(t.cycle_s[i] - ns_to_s(s.slot_period_ns)));
+      worst_fire = std::max(worst_fire, std::abs(t.fire_time_error_s[i]));
+    }
+    EXPECT_LT(worst_cycle, 1.5e-6) << "seed " << seed;
+    EXPECT_LT(worst_fire, 3e-4) << "seed " << seed;
+    EXPECT_EQ(t.misnamed, 0u) << "seed " << seed;
+    EXPECT_EQ(t.losses, 0u) << "seed " << seed;
+  }
+}
+
+// Sec. 3.9: echoes are gated out. The scenario's 5 % doubled: no seed diverges (every pose from
+// 20 s within 0.5 m of the path, the line past which every estimator counts as not localized,
+// accuracy/every_estimator_test.cpp), and the path error's standard deviation stays within 10 mm
+// of the clean run's; a silence of 2 s (every pulse in 13 slots missed) is survived too. (An echo
+// just over the gate still gets in now and then: one seed's worst pose under 10 % echoes is 0.32 m
+// off for a second, docs/accuracy-seed002.md.)
+TEST(KleemanOnSeed002, TenPercentEchoesAndTwoSecondsWithoutPulsesAreSurvived) {
+  const sim::Scenario clean = seed002();
+  sim::Scenario echoes = clean;
+  echoes.echo.probability = 0.10;
+  sim::Scenario outage = clean;
+  sim::apply_fault(outage, "tof_outage=60:62");
+  for (const sim::Scenario* s : {&echoes, &outage}) {
+    std::vector<double> path_std, baseline;
+    std::uint64_t gated = 0;
+    for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
+      const OfflineRunResult r = run_scenario_offline(*s, seed, "kleeman_iekf", {});
+      ASSERT_TRUE(r.metrics.path_error_std_m);
+      path_std.push_back(*r.metrics.path_error_std_m);
+      baseline.push_back(*run_scenario_offline(clean, seed, "kleeman_iekf", {}).metrics.path_error_std_m);
+      EXPECT_LT(*r.metrics.path_error_max_m, 0.5) << "seed " << seed;
+      gated += r.rejections.rejected("localizer.pulse.gated_nis");
+    }
+    std::printf("%s: path error std %.4f m (clean %.4f m), pulses gated %llu\n", s == &echoes ? "10 % echoes" : "2 s outage",
+                mean_of(path_std), mean_of(baseline), static_cast<unsigned long long>(gated));
+    EXPECT_LT(mean_of(path_std), mean_of(baseline) + 0.010);
+    if (s == &echoes) {
+      EXPECT_GT(gated, 500u);  // 10 % of 880 pulses a run over ten seeds, most of them gated
+    }
+  }
+}
+
+}  // namespace
+}  // namespace beaconloc
