@@ -35,6 +35,14 @@ void ReplaySource::refuse(const std::string& file, std::size_t line, const std::
     problems_.push_back(directory_ + "/" + file + ".csv:" + std::to_string(line) + ": " + detail);
 }
 
+void ReplaySource::note_if_earlier(const std::string& file, std::size_t line, StampNs previous_ns, StampNs stamp_ns) {
+  if (stamp_ns >= previous_ns || notes_.size() >= 20) return;
+  // Each row carries its own stamp: the rows are replayed in stamp order, and this is said.
+  notes_.push_back(directory_ + "/" + file + ".csv:" + std::to_string(line) + ": " +
+                   std::to_string(ns_to_s(previous_ns - stamp_ns)) + " s earlier than the row before; " + file +
+                   " are replayed in stamp order");
+}
+
 bool ReplaySource::complete(const CsvReader& csv, const std::string& file) {
   if (csv.complete()) return true;
   refuse(file, csv.line(), "malformed_row", csv.cell_count_problem());
@@ -185,12 +193,7 @@ void ReplaySource::load_ranges(const std::string& path) {
                  " (first at line " + std::to_string(first->second) + "); the first is replayed");
       continue;
     }
-    if (arrival_ns < previous && notes_.size() < 20) {
-      // Each row carries its own stamp: the rows are replayed in stamp order, and this is said.
-      notes_.push_back(directory_ + "/ranges.csv:" + std::to_string(csv.line()) + ": " +
-                       std::to_string(ns_to_s(previous - arrival_ns)) +
-                       " s earlier than the row before; ranges are replayed in stamp order");
-    }
+    note_if_earlier("ranges", csv.line(), previous, arrival_ns);
     previous = std::max(previous, arrival_ns);
     SourceEvent e;
     e.kind = SourceEvent::Kind::kTof;
@@ -225,11 +228,7 @@ void ReplaySource::load_pulses(const std::string& path) {
       continue;
     }
     const StampNs arrival_ns = s_to_ns(t);
-    if (arrival_ns < previous && notes_.size() < 20) {
-      notes_.push_back(directory_ + "/pulses.csv:" + std::to_string(csv.line()) + ": " +
-                       std::to_string(ns_to_s(previous - arrival_ns)) +
-                       " s earlier than the row before; pulses are replayed in stamp order");
-    }
+    note_if_earlier("pulses", csv.line(), previous, arrival_ns);
     previous = std::max(previous, arrival_ns);
     SourceEvent e;
     e.kind = SourceEvent::Kind::kPulse;

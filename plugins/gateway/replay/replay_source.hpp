@@ -75,6 +75,8 @@ class ReplaySource final : public Source {
   // not a number, invalid_<column> when it lies outside) and false returned.
   bool take(const CsvReader& csv, const std::string& file, const std::string& column, double& out, double min,
             double max);
+  // Notes (load_notes) a row of `file` stamped before the row before it.
+  void note_if_earlier(const std::string& file, std::size_t line, StampNs previous_ns, StampNs stamp_ns);
   void refuse(const std::string& file, std::size_t line, const std::string& reason,
               const std::string& detail);
 

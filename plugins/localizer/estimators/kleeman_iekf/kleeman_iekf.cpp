@@ -237,29 +237,23 @@ FilterOutcome KleemanIekf::advance_slots(std::int64_t slots) {
     const double period = x(idx::kCycle), from = x(idx::kFireTime);
     double dtheta = 0.0, dtheta_variance_rad2 = 0.0, unknown_travel_variance = 0.0;
     kleeman::SlotNoise noise = params_.noise;
-    if (params_.dead_reckoning && !heading_known_) {
-      // The heading unknown: no move along it (v = 0), the travel as noise; the turn as eq. 24.
+    if (params_.dead_reckoning) {
       const kleeman::DeadReckoning d = track_.between(from, from + period);
-      unknown_travel_variance = d.distance_m * d.distance_m + d.distance_variance_m2;
-      noise.speed_mps = 0.0;  // v stays 0: no pulse may find a speed along an unknown heading
-      dtheta = d.dtheta_rad;
-      const double model_sigma = params_.heading_offset_sigma_rad + params_.heading_fraction * std::abs(dtheta);
-      dtheta_variance_rad2 = d.dtheta_variance_rad2 + model_sigma * model_sigma;
-    } else if (params_.dead_reckoning) {
-      // Eq. 25: the slot's mean dead-reckoned speed measures v, the speed over the slot.
-      const kleeman::DeadReckoning d = track_.between(from, from + period);
-      const double variance =
-          d.distance_variance_m2 / (period * period) + params_.speed_sigma_mps * params_.speed_sigma_mps;
-      Mat<1, kleeman::kStateSize> h = Mat<1, kleeman::kStateSize>::Zero();
-      h(0, idx::kSpeed) = 1.0;
-      const UpdateResult speed =
-          filter_->update(LinearModel<1, kleeman::kStateSize>(h, Mat<1, 1>(variance)), Vec<1>(d.distance_m / period));
-      if (!speed.applied()) return speed.outcome;
-      // Eq. 24 and Sec. 3.10: the input dtheta, its variance the odometry's plus an offset and a
-      // fraction of the increment.
-      dtheta = d.dtheta_rad;
-      const double model_sigma = params_.heading_offset_sigma_rad + params_.heading_fraction * std::abs(dtheta);
-      dtheta_variance_rad2 = d.dtheta_variance_rad2 + model_sigma * model_sigma;
+      if (heading_known_) {
+        // Eq. 25: the slot's mean dead-reckoned speed measures v, the speed over the slot.
+        const SpeedMeasurement z = speed_over(d, period);
+        Mat<1, kleeman::kStateSize> h = Mat<1, kleeman::kStateSize>::Zero();
+        h(0, idx::kSpeed) = 1.0;
+        const UpdateResult speed =
+            filter_->update(LinearModel<1, kleeman::kStateSize>(h, Mat<1, 1>(z.variance_m2ps2)), Vec<1>(z.speed_mps));
+        if (!speed.applied()) return speed.outcome;
+      } else {
+        // The heading unknown: no move along it (v = 0), the travel as noise.
+        unknown_travel_variance = d.distance_m * d.distance_m + d.distance_variance_m2;
+        noise.speed_mps = 0.0;  // v stays 0: no pulse may find a speed along an unknown heading
+      }
+      dtheta = d.dtheta_rad;  // eq. 24
+      dtheta_variance_rad2 = dtheta_input_variance(d);
     } else if (!heading_known_) {
       // No dead reckoning and no heading yet: a random walk of the robot's top speed, v = 0.
       const double step = params_.unknown_speed_mps * period;
@@ -277,6 +271,16 @@ FilterOutcome KleemanIekf::advance_slots(std::int64_t slots) {
     if (!params_.dead_reckoning && !heading_known_) heading_from_travel();
   }
   return FilterOutcome::kApplied;
+}
+
+KleemanIekf::SpeedMeasurement KleemanIekf::speed_over(const kleeman::DeadReckoning& d, double period_s) const {
+  return {d.distance_m / period_s,
+          d.distance_variance_m2 / (period_s * period_s) + params_.speed_sigma_mps * params_.speed_sigma_mps};
+}
+
+double KleemanIekf::dtheta_input_variance(const kleeman::DeadReckoning& d) const {
+  const double model_sigma = params_.heading_offset_sigma_rad + params_.heading_fraction * std::abs(d.dtheta_rad);
+  return d.dtheta_variance_rad2 + model_sigma * model_sigma;
 }
 
 void KleemanIekf::remember(const kleeman::SlotPulse& pulse) {

@@ -122,6 +122,15 @@ class KleemanIekf final : public EstimatorBase {
   bool heard_before(const PulseArrivalSample& pulse);
   // Back to start-up (a map change, or what lose() says).
   void reset_tracking();
+  // Eq. 25: the dead-reckoned mean speed over a slot (d, of period_s) as a measurement of v.
+  struct SpeedMeasurement {
+    double speed_mps = 0.0;
+    double variance_m2ps2 = 0.0;
+  };
+  SpeedMeasurement speed_over(const kleeman::DeadReckoning& d, double period_s) const;
+  // Sec. 3.10: the variance of the heading input dtheta (eq. 24): the odometry's, plus an offset
+  // and a fraction of the increment, squared.
+  double dtheta_input_variance(const kleeman::DeadReckoning& d) const;
   double heading_ok_variance() const { return params_.max_ok_heading_sigma_rad * params_.max_ok_heading_sigma_rad; }
   void refit_heading();
   // Leaves the mode of an unknown heading (heading_known_) with the speed of the dead reckoning.

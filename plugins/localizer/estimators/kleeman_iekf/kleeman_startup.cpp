@@ -119,10 +119,9 @@ bool KleemanIekf::start_from_fit(const kleeman::StartupFit& fit, StampNs stamp_n
   x(idx::kSpeed) = 0.0;
   p(idx::kSpeed, idx::kSpeed) = 1.0;  // without dead reckoning: a speed within a few m/s
   if (params_.dead_reckoning) {
-    const kleeman::DeadReckoning before = track_.between(fire_s - period, fire_s);
-    x(idx::kSpeed) = before.distance_m / period;
-    p(idx::kSpeed, idx::kSpeed) =
-        before.distance_variance_m2 / (period * period) + params_.speed_sigma_mps * params_.speed_sigma_mps;
+    const SpeedMeasurement before = speed_over(track_.between(fire_s - period, fire_s), period);
+    x(idx::kSpeed) = before.speed_mps;
+    p(idx::kSpeed, idx::kSpeed) = before.variance_m2ps2;
   }
   if (!heading_known_) {
     x(idx::kSpeed) = 0.0;
@@ -220,11 +219,11 @@ void KleemanIekf::know_heading() {
   State x = filter_->state();
   Covariance p = filter_->covariance();
   const double period = x(idx::kCycle);
-  const kleeman::DeadReckoning d = track_.between(x(idx::kFireTime) - period, x(idx::kFireTime));
-  x(idx::kSpeed) = d.distance_m / period;
+  const SpeedMeasurement before = speed_over(track_.between(x(idx::kFireTime) - period, x(idx::kFireTime)), period);
+  x(idx::kSpeed) = before.speed_mps;
   p.row(idx::kSpeed).setZero();
   p.col(idx::kSpeed).setZero();
-  p(idx::kSpeed, idx::kSpeed) = d.distance_variance_m2 / (period * period) + params_.speed_sigma_mps * params_.speed_sigma_mps;
+  p(idx::kSpeed, idx::kSpeed) = before.variance_m2ps2;
   filter_->reset(x, p);
 }
 
