@@ -82,7 +82,10 @@ Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estima
       throw std::invalid_argument("evaluate: an estimate at stamp " + std::to_string(row.estimate.stamp_ns) +
                                   " is not finite");
     }
-    if (row.estimate.stamp_ns < options.score_from_ns) continue;
+    if (row.estimate.stamp_ns < options.score_from_ns) {
+      ++m.samples_before_scoring;
+      continue;
+    }
     const auto t = truth.at(row.estimate.stamp_ns, options.max_truth_gap_ns);
     if (!t) {
       ++m.samples_without_truth;
@@ -261,6 +264,7 @@ void write_metrics_json(const std::string& path, const Metrics& m, const std::st
       << "  \"source\": " << quoted(source) << ",\n"
       << "  \"samples\": " << m.samples << ",\n"
       << "  \"samples_without_truth\": " << m.samples_without_truth << ",\n"
+      << "  \"samples_before_scoring\": " << m.samples_before_scoring << ",\n"
       << "  \"position_rms_m\": " << optional(figure(m.position_rms_m)) << ",\n"
       << "  \"position_mean_m\": " << optional(figure(m.position_mean_m)) << ",\n"
       << "  \"position_max_m\": " << optional(figure(m.position_max_m)) << ",\n"

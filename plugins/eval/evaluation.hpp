@@ -30,6 +30,7 @@ struct EvaluationOptions {
 struct Metrics {
   std::size_t samples = 0;  // estimates scored (truth known at their stamp)
   std::size_t samples_without_truth = 0;
+  std::size_t samples_before_scoring = 0;  // estimates before EvaluationOptions::score_from_ns
   double position_rms_m = 0.0;
   double position_mean_m = 0.0;
   double position_max_m = 0.0;
