@@ -136,15 +136,18 @@ Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estima
   if (heading.samples()) {
     m.heading_rms_deg = heading.heading_rms_deg();
     m.significant_points_mean_m = sum_es / static_cast<double>(heading.samples());
-    double mean = 0.0, max_abs = 0.0;
+    double mean = 0.0, max_abs = 0.0, square = 0.0;
     for (const double e : path_errors) {
       mean += e;
+      square += e * e;
       max_abs = std::max(max_abs, std::abs(e));
     }
-    mean /= static_cast<double>(path_errors.size());
+    const auto n = static_cast<double>(path_errors.size());
+    mean /= n;
     double var = 0.0;
     for (const double e : path_errors) var += (e - mean) * (e - mean);
-    m.path_error_std_m = std::sqrt(var / static_cast<double>(path_errors.size()));
+    m.path_error_std_m = std::sqrt(var / n);
+    m.path_error_rms_m = std::sqrt(square / n);
     m.path_error_max_m = max_abs;
   }
   return m;

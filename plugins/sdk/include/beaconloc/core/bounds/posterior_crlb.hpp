@@ -1,8 +1,9 @@
 #pragma once
 // The posterior Cramer-Rao lower bound (PCRB; Tichavsky, Muravchik and Nehorai, "Posterior
 // Cramer-Rao bounds for discrete-time nonlinear filtering", IEEE TSP 1998) along a true
-// trajectory: no estimator of the state from the same data can have a smaller error covariance
-// than it (in the positive semi-definite sense), on average over the noise.
+// trajectory: a Bayesian (Van Trees) bound, so no estimator of the state from the same data and
+// prior can have a smaller mean square error matrix than it (in the positive semi-definite sense),
+// on average over the noise and the prior.
 //
 // For additive Gaussian noises the recursion for the information J_k = P_k^-1 is
 //   J_k+1 = (F P_k F^T + G U G^T + Q)^-1 + H^T R^-1 H,
@@ -12,10 +13,12 @@
 // Its assumptions, to say beside any figure it prints:
 //  - the models are the ones that made the data (the simulator's noise models, their sizes);
 //  - every measurement fed is a true one (an echo is not fed: the bound assumes it recognised);
-//  - it bounds the error of unbiased estimators; a biased one (a prior pulling it) may go below;
-//  - it averages over the noise along one trajectory: the Jacobians are not averaged over the
+//  - a noise's covariance is taken as given at the true input: where it depends on the state
+//    (wheel noise growing with the speed) the information that dependence carries is left out;
+//  - it follows one trajectory: the Jacobians are taken at the truth, not averaged over the
 //    state's distribution, which is exact for the linear-Gaussian case and the usual
-//    approximation elsewhere.
+//    approximation elsewhere. So it is a bound on average over many runs; one run's error may
+//    fall below it.
 // The Kalman filter on a linear-Gaussian model meets it exactly (tests/unit/posterior_crlb_test).
 #include "beaconloc/core/filters/gaussian_filter.hpp"
 
