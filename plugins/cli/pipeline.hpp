@@ -66,7 +66,6 @@ struct PipelineOptions {
   bool processes = false;       // one process per participant
   bool print_poses = false;     // a pose line each second (demo)
   bool print_progress = false;  // a progress line every 2 s (run)
-  StampNs score_from_ns = 0;    // settle time not scored, from the first pose
 };
 
 struct PipelineResult {

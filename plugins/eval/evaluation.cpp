@@ -82,7 +82,10 @@ Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estima
       throw std::invalid_argument("evaluate: an estimate at stamp " + std::to_string(row.estimate.stamp_ns) +
                                   " is not finite");
     }
-    if (row.estimate.stamp_ns < options.score_from_ns) continue;
+    if (row.estimate.stamp_ns < options.score_from_ns) {
+      ++m.samples_before_scoring;
+      continue;
+    }
     const auto t = truth.at(row.estimate.stamp_ns, options.max_truth_gap_ns);
     if (!t) {
       ++m.samples_without_truth;
@@ -133,15 +136,18 @@ Metrics evaluate(const TruthTrack& truth, const std::vector<EstimateRow>& estima
   if (heading.samples()) {
     m.heading_rms_deg = heading.heading_rms_deg();
     m.significant_points_mean_m = sum_es / static_cast<double>(heading.samples());
-    double mean = 0.0, max_abs = 0.0;
+    double mean = 0.0, max_abs = 0.0, square = 0.0;
     for (const double e : path_errors) {
       mean += e;
+      square += e * e;
       max_abs = std::max(max_abs, std::abs(e));
     }
-    mean /= static_cast<double>(path_errors.size());
+    const auto n = static_cast<double>(path_errors.size());
+    mean /= n;
     double var = 0.0;
     for (const double e : path_errors) var += (e - mean) * (e - mean);
-    m.path_error_std_m = std::sqrt(var / static_cast<double>(path_errors.size()));
+    m.path_error_std_m = std::sqrt(var / n);
+    m.path_error_rms_m = std::sqrt(square / n);
     m.path_error_max_m = max_abs;
   }
   return m;
@@ -261,6 +267,7 @@ void write_metrics_json(const std::string& path, const Metrics& m, const std::st
       << "  \"source\": " << quoted(source) << ",\n"
       << "  \"samples\": " << m.samples << ",\n"
       << "  \"samples_without_truth\": " << m.samples_without_truth << ",\n"
+      << "  \"samples_before_scoring\": " << m.samples_before_scoring << ",\n"
       << "  \"position_rms_m\": " << optional(figure(m.position_rms_m)) << ",\n"
       << "  \"position_mean_m\": " << optional(figure(m.position_mean_m)) << ",\n"
       << "  \"position_max_m\": " << optional(figure(m.position_max_m)) << ",\n"

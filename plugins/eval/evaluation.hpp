@@ -30,6 +30,7 @@ struct EvaluationOptions {
 struct Metrics {
   std::size_t samples = 0;  // estimates scored (truth known at their stamp)
   std::size_t samples_without_truth = 0;
+  std::size_t samples_before_scoring = 0;  // estimates before EvaluationOptions::score_from_ns
   double position_rms_m = 0.0;
   double position_mean_m = 0.0;
   double position_max_m = 0.0;
@@ -39,6 +40,7 @@ struct Metrics {
   // across the true heading at the pose's stamp (on a straight leg, the distance to the path the
   // paper measured; a lag along the path does not count). Where truth has heading.
   std::optional<double> path_error_std_m;
+  std::optional<double> path_error_rms_m;  // with its mean (the figure a bound on the error is read against)
   std::optional<double> path_error_max_m;  // of its magnitude
   double nees_in_band_fraction = 0.0;
   int nees_dof = 3;  // 3 with heading in the truth, else 2 (position only)

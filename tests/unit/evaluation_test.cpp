@@ -64,6 +64,30 @@ TEST(Evaluation, NeesBandTellsHonestFromOverconfidentCovariances) {
               1e-12);
 }
 
+// Seed 002's path error: its RMS keeps the mean its standard deviation takes out (rms^2 = std^2 +
+// mean^2), and estimates before score_from_ns are counted, not scored.
+TEST(Evaluation, PathErrorRmsKeepsItsMeanAndEstimatesBeforeScoringAreCounted) {
+  const TruthTrack truth = circle_track(true);
+  std::vector<EstimateRow> rows = shifted(truth, {0.0, 0.0, 0.0}, 1e-4 * Cov3::Identity());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    // 2 cm to the left of the path, +-1 cm alternating: mean 0.02 m, std 0.01 m across the path
+    const double yaw = rows[i].estimate.pose_map_base.z(), across = 0.02 + (i % 2 ? 0.01 : -0.01);
+    rows[i].estimate.pose_map_base.x() -= across * std::sin(yaw);
+    rows[i].estimate.pose_map_base.y() += across * std::cos(yaw);
+  }
+  const Metrics all = evaluate(truth, rows);
+  ASSERT_TRUE(all.path_error_std_m && all.path_error_rms_m);
+  EXPECT_NEAR(*all.path_error_rms_m * *all.path_error_rms_m,
+              *all.path_error_std_m * *all.path_error_std_m + 0.02 * 0.02, 1e-6);
+  EXPECT_NEAR(*all.path_error_std_m, 0.01, 2e-3);
+  EXPECT_EQ(all.samples_before_scoring, 0u);
+  EvaluationOptions later;
+  later.score_from_ns = rows[10].estimate.stamp_ns;
+  const Metrics from_tenth = evaluate(truth, rows, later);
+  EXPECT_EQ(from_tenth.samples_before_scoring, 10u);
+  EXPECT_EQ(from_tenth.samples, all.samples - 10);
+}
+
 TEST(Evaluation, TruthWithoutHeadingScoresPositionOnlyAndInterpolates) {
   TruthTrack truth;
   truth.add(0, {0.0, 0.0, 0.0}, false);

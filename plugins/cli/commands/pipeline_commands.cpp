@@ -42,7 +42,8 @@ class PipelineCommand : public Command {
       return 1;
     }
     if (has_truth && r.metrics.samples == 0) {
-      std::cerr << "beaconloc: no pose was at a stamp the ground truth covers\n";
+      std::cerr << "beaconloc: no pose was at a stamp the ground truth covers"
+                << (r.metrics.samples_before_scoring ? " from the scenario's score_from_s" : "") << '\n';
       return 1;
     }
     return 0;
