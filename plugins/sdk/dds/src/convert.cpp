@@ -127,11 +127,15 @@ msg::LaserScan to_msg(const std::string& robot_id, const LaserScanSample& s) {
   return m;
 }
 
-std::vector<Beacon> from_msg(const msg::BeaconMap& m) {
-  std::vector<Beacon> beacons;
-  beacons.reserve(m.beacons().size());
+BeaconList from_msg(const msg::BeaconMap& m) {
+  BeaconList beacons;
   for (const auto& b : m.beacons()) {
-    beacons.push_back({b.id(), {b.x_m(), b.y_m(), b.z_m()}, b.group()});
+    const Eigen::Vector3d position_m(b.x_m(), b.y_m(), b.z_m());
+    if (b.frame() == msg::BEACON_FRAME_GROUP) {
+      beacons.group_frame.push_back({b.id(), b.group(), position_m});
+    } else {
+      beacons.map_frame.push_back({b.id(), position_m, b.group()});
+    }
   }
   return beacons;
 }
@@ -146,6 +150,17 @@ msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id) {
     mb.y_m(b.position_map_m.y());
     mb.z_m(b.position_map_m.z());
     mb.group(b.group);
+    mb.frame(msg::BEACON_FRAME_MAP);
+    m.beacons().push_back(mb);
+  }
+  for (const LocalBeacon& b : map.local_beacons()) {
+    msg::Beacon mb;
+    mb.id(b.id);
+    mb.x_m(b.position_group_m.x());
+    mb.y_m(b.position_group_m.y());
+    mb.z_m(b.position_group_m.z());
+    mb.group(b.group);
+    mb.frame(msg::BEACON_FRAME_GROUP);
     m.beacons().push_back(mb);
   }
   return m;
