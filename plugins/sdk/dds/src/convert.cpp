@@ -140,28 +140,29 @@ BeaconList from_msg(const msg::BeaconMap& m) {
   return beacons;
 }
 
+namespace {
+
+msg::Beacon beacon_msg(std::uint32_t id, const Eigen::Vector3d& position_m, std::uint32_t group, msg::BeaconFrame frame) {
+  msg::Beacon mb;
+  mb.id(id);
+  mb.x_m(position_m.x());
+  mb.y_m(position_m.y());
+  mb.z_m(position_m.z());
+  mb.group(group);
+  mb.frame(frame);
+  return mb;
+}
+
+}  // namespace
+
 msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id) {
   msg::BeaconMap m;
   m.frame_id(frame_id);
-  for (const auto& b : map.beacons()) {
-    msg::Beacon mb;
-    mb.id(b.id);
-    mb.x_m(b.position_map_m.x());
-    mb.y_m(b.position_map_m.y());
-    mb.z_m(b.position_map_m.z());
-    mb.group(b.group);
-    mb.frame(msg::BEACON_FRAME_MAP);
-    m.beacons().push_back(mb);
+  for (const Beacon& b : map.beacons()) {
+    m.beacons().push_back(beacon_msg(b.id, b.position_map_m, b.group, msg::BEACON_FRAME_MAP));
   }
   for (const LocalBeacon& b : map.local_beacons()) {
-    msg::Beacon mb;
-    mb.id(b.id);
-    mb.x_m(b.position_group_m.x());
-    mb.y_m(b.position_group_m.y());
-    mb.z_m(b.position_group_m.z());
-    mb.group(b.group);
-    mb.frame(msg::BEACON_FRAME_GROUP);
-    m.beacons().push_back(mb);
+    m.beacons().push_back(beacon_msg(b.id, b.position_group_m, b.group, msg::BEACON_FRAME_GROUP));
   }
   return m;
 }
