@@ -9,6 +9,7 @@
 
 #include "beaconloc/core/csv_reader.hpp"
 #include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/estimator_registry.hpp"
 #include "offline_run.hpp"
 #include "sim/scenario_yaml.hpp"
 #include "tof_decoder.hpp"
@@ -36,6 +37,12 @@ TEST(BeaconReferencing, TheMapFindsOnlyBeaconsWithAMapPosition) {
   moved.group_frame.pop_back();
   moved.map_frame.push_back({32, {-0.35, 0.35, 3.0}, 4});
   EXPECT_NE(BeaconMap(moved), map);
+  BeaconList shifted = two_kinds();  // only a local beacon's position differs
+  shifted.group_frame[1].position_group_m.x() += 0.01;
+  EXPECT_NE(BeaconMap(shifted), map);
+  BeaconList regrouped = two_kinds();  // only a local beacon's group differs
+  regrouped.group_frame[1].group = 4;
+  EXPECT_NE(BeaconMap(regrouped), map);
 }
 
 TEST(BeaconReferencing, AMapMixingTheKindsWronglyIsRefusedWithTheReason) {
@@ -110,8 +117,8 @@ TEST(BeaconReferencing, Seed003PublishesItsLocalGroupsInTheirOwnFrames) {
   EXPECT_GT((b41->position_group_m.head<2>() - Eigen::Vector2d(0.3535533906, 0.3535533906)).norm(), 0.1);
 }
 
-// Today no estimator calibrates: on seed 003 range_ekf localizes on the two GRULPSs' beacons
-// alone, and every range to an LRULPS beacon is refused as uncalibrated, counted.
+// Today no estimator calibrates: on seed 003 every estimator that takes ranges refuses each range
+// to an LRULPS beacon, as uncalibrated (or, in a mode that uses no beacon, as unused), counted.
 TEST(BeaconReferencing, OnSeed003NoEstimatorUsesAnUncalibratedBeacon) {
   const sim::Scenario s = seed003();
   std::uint64_t local_tofs = 0;
@@ -120,13 +127,45 @@ TEST(BeaconReferencing, OnSeed003NoEstimatorUsesAnUncalibratedBeacon) {
     local_tofs += e.kind == SourceEvent::Kind::kTof && s.local_group_frames_map.count(b->group);
   }
   EXPECT_GT(local_tofs, 500u);
-  const OfflineRunResult r = run_scenario_offline(s, 1, "range_ekf", {});
-  // Every one of them, but those the decoder refused first (a TOF past the range limit by its noise).
-  const std::uint64_t uncalibrated = r.rejections.rejected("localizer.range.uncalibrated_beacon");
-  EXPECT_LE(uncalibrated, local_tofs);
-  EXPECT_GE(uncalibrated, local_tofs - r.rejections.rejected("decoder.out_of_range_tof"));
-  EXPECT_EQ(r.rejections.rejected("decoder.unknown_beacon"), 0u);
-  EXPECT_EQ(r.rejections.rejected("localizer.range.unknown_beacon"), 0u);
+  int checked = 0;
+  for (const std::string& name : EstimatorRegistry::instance().names()) {
+    SCOPED_TRACE(name);
+    if (EstimatorRegistry::instance().reference_scenario(name).empty()) continue;  // a test double, not the product's
+    EstimatorConfig config;
+    config.receivers = s.receivers;
+    std::unique_ptr<Estimator> probe;
+    try {
+      probe = EstimatorRegistry::instance().create(name, config);
+    } catch (const std::invalid_argument&) {
+      continue;  // not for this robot (duhl needs its three receivers)
+    }
+    if (probe->beacon_input() != BeaconInput::kRanges) continue;
+    const OfflineRunResult r = run_scenario_offline(s, 1, name, {});
+    // Every one of them, but those the decoder refused first (a TOF past the range limit by its noise).
+    const std::uint64_t refused = r.rejections.rejected("localizer.range.uncalibrated_beacon") +
+                                  r.rejections.rejected("localizer.range.beacons_unused");
+    EXPECT_GE(refused, local_tofs - r.rejections.rejected("decoder.out_of_range_tof"));
+    EXPECT_EQ(r.rejections.rejected("decoder.unknown_beacon"), 0u);
+    EXPECT_EQ(r.rejections.rejected("localizer.range.unknown_beacon"), 0u);
+    ++checked;
+  }
+  EXPECT_GE(checked, 2);  // range_ekf, ukf_lrf_beacons_only (duhl and uhl_last2 need three receivers, ukf_lrf a laser)
+}
+
+// Seed 002's estimator cannot model beacons whose positions it does not know firing in its
+// cycle: a map with any is refused with the reason, not half used.
+TEST(BeaconReferencing, KleemanRefusesAMapWithLocallyReferencedBeacons) {
+  EstimatorConfig config;
+  config.receivers.receivers_base_m.push_back(Eigen::Vector2d::Zero());
+  auto k = EstimatorRegistry::instance().create("kleeman_iekf", config);
+  k->set_beacon_map(BeaconMap(BeaconList({{1, {0, 0, 3}, 1}, {2, {5, 0, 3}, 1}, {3, {0, 5, 3}, 1}},
+                                         {{41, 4, {0.3, 0.3, 3.0}}})));
+  PulseArrivalSample p;
+  p.stamp_ns = 1'000'000'000;
+  p.mark = PulseMark::kDouble;
+  const InputResult r = k->update_pulse(p);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_EQ(r.rejection, Rejection::kBeaconMapUnusable);
 }
 
 std::string scenario_error(const std::string& groups) {
@@ -174,7 +213,7 @@ TEST(BeaconReferencing, BeaconsCsvSaysEachBeaconsFrameAndRefusesWhatItCannotMean
     }
     return std::string();
   };
-  EXPECT_NE(error("1,0,0,3,0,group\n").find("bad.csv:2: beacon 1 in frame group needs its group"), std::string::npos);
+  EXPECT_NE(error("1,0,0,3,0,group\n").find("bad.csv: beacon 1: local_without_group"), std::string::npos);
   EXPECT_NE(error("1,0,0,3,1,grop\n").find("frame 'grop' is neither map nor group"), std::string::npos);
   EXPECT_NE(error("1,0,0,3,1,map\n2,0,0,3,1,group\n").find("beacon 2: group_both_kinds"), std::string::npos);
   // A file without the columns is the map frame, group 0, as before.

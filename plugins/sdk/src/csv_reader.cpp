@@ -115,8 +115,7 @@ BeaconMap load_beacon_map_csv(const std::string& path) {
     if (frame == "map") {
       beacons.map_frame.push_back({id, {x, y, z}, group});
     } else if (frame == "group") {
-      if (group == 0) throw CsvError(csv.where() + ": beacon " + std::to_string(id) + " in frame group needs its group (not 0)");
-      beacons.group_frame.push_back({id, group, {x, y, z}});
+      beacons.group_frame.push_back({id, group, {x, y, z}});  // group 0: check_beacons refuses it below
     } else {
       throw CsvError(csv.where() + ": malformed beacon row: frame '" + frame + "' is neither map nor group");
     }

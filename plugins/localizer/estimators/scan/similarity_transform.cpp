@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <cmath>
+#include <stdexcept>
 
 namespace beaconloc::scan {
 namespace {
@@ -72,7 +73,7 @@ TransformFit analytic_similarity(const PointPair& newer, const PointPair& older,
   t_a << rows_of(newer.local_m), rows_of(older.local_m);
   Eigen::Vector4d t_b;  // eq. 40
   t_b << newer.global_m, older.global_m;
-  // det T_A = -|p_k - p_k-t|^2: singular only where the two local points coincide.
+  // det T_A = |p_k - p_k-t|^2: singular only where the two local points coincide.
   const Eigen::FullPivLU<Eigen::Matrix4d> lu(t_a);
   if (!lu.isInvertible()) return failed(TransformFailure::kSingular);
   TransformFit fit;
@@ -91,16 +92,21 @@ TransformFit numerical_similarity(const std::vector<PointPair>& pairs, const Num
   std::optional<Eigen::Vector4d> t = weighted_fit(pairs, weights);  // least squares: the start
   if (!t) return failed(TransformFailure::kSingular);
   TransformFit fit;
-  for (fit.iterations = 1; fit.iterations < options.max_iterations; ++fit.iterations) {
+  fit.iterations = 1;  // the least-squares start
+  while (fit.iterations < options.max_iterations) {
     const Similarity2 current{*t};
     for (std::size_t i = 0; i < pairs.size(); ++i) {
       weights[i] = 1.0 / std::max((current.apply(pairs[i].local_m) - pairs[i].global_m).norm(), options.distance_floor_m);
     }
     const std::optional<Eigen::Vector4d> next = weighted_fit(pairs, weights);
     if (!next) break;  // keep the last good one
+    ++fit.iterations;
     const double step = (*next - *t).norm();
     t = next;
-    if (step < options.tolerance) break;
+    if (step < options.tolerance * std::max(1.0, t->norm())) {
+      fit.converged = true;
+      break;
+    }
   }
   fit.transform = Similarity2{*t};
   fit.mean_error_m = mean_error_m(*fit.transform, pairs);
@@ -117,6 +123,12 @@ std::vector<PointPair> spread_points(const std::vector<PointPair>& track_newest_
     if (apart) kept.push_back(*it);
   }
   return kept;
+}
+
+AnalyticAverage::AnalyticAverage(double min_separation_m) : min_separation_m_(min_separation_m) {
+  if (!(std::isfinite(min_separation_m) && min_separation_m > 0.0)) {
+    throw std::invalid_argument("AnalyticAverage: d_min must be a finite distance > 0");
+  }
 }
 
 TransformFailure AnalyticAverage::add(const PointPair& pair) {

@@ -48,6 +48,7 @@ struct TransformFit {
   TransformFailure failure = TransformFailure::kNone;
   double mean_error_m = 0.0;  // eq. 46 over the pairs used
   int iterations = 0;         // numerical: reweighted solves
+  bool converged = false;     // numerical: T_C stopped moving before max_iterations
 };
 
 // Eq. 39-41 from two pairs whose local points are at least min_separation_m (d_min) apart.
@@ -55,7 +56,7 @@ TransformFit analytic_similarity(const PointPair& newer, const PointPair& older,
 
 struct NumericalOptions {
   int max_iterations = 100;
-  double tolerance = 1e-10;       // stop when T_C moves less than this (its norm)
+  double tolerance = 1e-10;       // stop when T_C moves less than this, relative to its norm (at least 1)
   double distance_floor_m = 1e-6;  // a weight's distance never below this (a point fitted exactly)
 };
 // Eq. 44-47 over every pair given (pick them with spread_points).
@@ -73,7 +74,8 @@ class AnalyticAverage {
  public:
   static constexpr double kTrackSpacingM = 0.01;
   static constexpr std::size_t kMaxTrackPairs = 10000;  // 100 m of overlap at kTrackSpacingM
-  explicit AnalyticAverage(double min_separation_m) : min_separation_m_(min_separation_m) {}
+  // Throws std::invalid_argument unless d_min is finite and > 0.
+  explicit AnalyticAverage(double min_separation_m);
   // kNone when this pair added a vector to the average; why not otherwise.
   TransformFailure add(const PointPair& pair);
   std::size_t count() const { return count_; }

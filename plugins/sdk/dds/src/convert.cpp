@@ -131,10 +131,13 @@ BeaconList from_msg(const msg::BeaconMap& m) {
   BeaconList beacons;
   for (const auto& b : m.beacons()) {
     const Eigen::Vector3d position_m(b.x_m(), b.y_m(), b.z_m());
-    if (b.frame() == msg::BEACON_FRAME_GROUP) {
-      beacons.group_frame.push_back({b.id(), b.group(), position_m});
-    } else {
-      beacons.map_frame.push_back({b.id(), position_m, b.group()});
+    switch (b.frame()) {  // a frame the IDL does not define never gets here (checked_type.hpp)
+      case msg::BEACON_FRAME_GROUP:
+        beacons.group_frame.push_back({b.id(), b.group(), position_m});
+        break;
+      case msg::BEACON_FRAME_MAP:
+        beacons.map_frame.push_back({b.id(), position_m, b.group()});
+        break;
     }
   }
   return beacons;

@@ -94,6 +94,8 @@ TEST(SimilarityTransform, TheNumericalFitRecoversAnExactTransformAndSpreadsItsPo
   const TransformFit fit = numerical_similarity(points);
   ASSERT_EQ(fit.failure, TransformFailure::kNone);
   EXPECT_TRUE(fit.transform->t_c.isApprox(truth().t_c, 1e-8));
+  EXPECT_THROW(AnalyticAverage(0.0), std::invalid_argument);
+  EXPECT_THROW(AnalyticAverage(std::nan("")), std::invalid_argument);
 }
 
 // Eq. 46 is a mean distance, not a mean square: one point 1 m off (an estimate after an echo)
@@ -106,6 +108,7 @@ TEST(SimilarityTransform, TheNumericalFitMinimizesTheMeanDistanceAndResistsAnOut
   ASSERT_EQ(fit.failure, TransformFailure::kNone);
   const TransformFit least_squares = numerical_similarity(points, {1, 1e-10, 1e-6});  // the start alone
   EXPECT_GT(fit.iterations, 1);
+  EXPECT_TRUE(fit.converged);
   EXPECT_LE(fit.mean_error_m, least_squares.mean_error_m);
   EXPECT_LT(beacon_error_m(*fit.transform), 0.5 * beacon_error_m(*least_squares.transform));
 }
