@@ -53,7 +53,8 @@ geometry_msgs::msg::TransformStamped to_transform(StampNs stamp_ns, const Pose2&
                                                   const std::string& parent, const std::string& child,
                                                   double z_m = 0.0);
 
-// One sphere per beacon (and its id as text above it), in the map frame.
+// One sphere per beacon with a map position (and its id as text above it), in the map frame; a
+// locally referenced beacon (seed 003, not calibrated) has none to draw.
 visualization_msgs::msg::MarkerArray beacon_markers(const BeaconMap& map, const std::string& map_frame,
                                                     StampNs stamp_ns);
 

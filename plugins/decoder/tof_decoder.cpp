@@ -67,7 +67,7 @@ DecodeOutcome TofDecoder::decode(const std::string& robot_id, const RawTofSample
   return decode_with_map(robot_id, tof, range_m);
 }
 
-std::vector<DecodedRange> TofDecoder::on_beacon_map(const std::vector<Beacon>& beacons) {
+std::vector<DecodedRange> TofDecoder::on_beacon_map(const BeaconList& beacons) {
   const std::optional<BeaconMap> map = counted_beacon_map(beacons, counts_);
   return map ? set_beacon_map(*map) : std::vector<DecodedRange>{};
 }
@@ -88,7 +88,11 @@ std::vector<DecodedRange> TofDecoder::set_beacon_map(const BeaconMap& map) {
 DecodeOutcome TofDecoder::decode_with_map(const std::string& robot_id, const RawTofSample& tof,
                                           double range_m) {
   const bool identified = tof.beacon_id != kBeaconUnidentified;
-  if (identified && !map_.find(tof.beacon_id)) return reject(Rejection::kUnknownBeacon);
+  // A locally referenced beacon's range is a range like any other (its group's calibration needs
+  // it); whether its position is known is the estimator's question.
+  if (identified && !map_.find(tof.beacon_id) && !map_.find_local(tof.beacon_id)) {
+    return reject(Rejection::kUnknownBeacon);
+  }
 
   RobotState& robot = robots_[robot_id];
   bool new_time_line = false;

@@ -67,7 +67,7 @@ class TofDecoder {
   std::vector<DecodedRange> set_beacon_map(const BeaconMap& map);
   // A map as received (the bus): one that check_beacons refuses is counted as
   // beacon_map.<reason> and the map in use is kept (nothing decoded then).
-  std::vector<DecodedRange> on_beacon_map(const std::vector<Beacon>& beacons);
+  std::vector<DecodedRange> on_beacon_map(const BeaconList& beacons);
   static constexpr std::size_t kMaxBacklog = 64;
   bool has_beacon_map() const { return !map_.empty(); }
   DecodeOutcome decode(const std::string& robot_id, const RawTofSample& tof);

@@ -16,7 +16,7 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
   beacon_input_ = probe->beacon_input();
 }
 
-bool LocalizerCore::on_beacon_map(const std::vector<Beacon>& beacons) {
+bool LocalizerCore::on_beacon_map(const BeaconList& beacons) {
   const std::optional<BeaconMap> map = counted_beacon_map(beacons, counts_);
   if (map) set_beacon_map(*map);
   return map.has_value();

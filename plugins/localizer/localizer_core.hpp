@@ -47,7 +47,7 @@ class LocalizerCore {
 
   // A beacon map as received (the bus): refused whole, counted as beacon_map.<reason>, when
   // check_beacons refuses it; the map in use is kept then. Returns whether it was taken.
-  bool on_beacon_map(const std::vector<Beacon>& beacons);
+  bool on_beacon_map(const BeaconList& beacons);
   // The first map is given to every robot's estimator; the same map again (a restarted gateway)
   // changes nothing; a different one (beacons moved, added or gone) restarts every robot on it:
   // what an estimator holds was measured against the old beacons (restart_robot).

@@ -44,8 +44,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // What the localizer, decoder and bridge do with it: check it whole (check_beacons), then take
   // it or refuse it with a reason. A refused map names a problem that is there; a taken one
   // holds every beacon sent, each finite and in bounds, and survives the wire unchanged.
-  const std::vector<Beacon> sent = dds::from_msg(m);
-  check(sent.size() == m.beacons().size());
+  const BeaconList sent = dds::from_msg(m);
+  check(sent.map_frame.size() + sent.group_frame.size() == m.beacons().size());
   BeaconMapCheck verdict;
   const std::optional<BeaconMap> map = BeaconMap::from(sent, &verdict);
   check(map.has_value() == verdict.ok());
@@ -55,16 +55,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check(!reason.empty() && reason != "unknown");
     return 0;
   }
-  check(map->size() == sent.size());  // no id repeated: nothing overwritten
-  for (const auto& b : sent) {
+  // No id repeated: nothing overwritten; a locally referenced beacon never found as a map one.
+  check(map->size() == sent.map_frame.size() && map->local_size() == sent.group_frame.size());
+  for (const auto& b : sent.map_frame) {
     const Beacon* found = map->find(b.id);
     check(found != nullptr && found->position_map_m.allFinite() &&
           found->position_map_m.cwiseAbs().maxCoeff() <= kMaxMapCoordinateM);
   }
+  for (const auto& b : sent.group_frame) check(!map->find(b.id) && map->find_local(b.id) && b.group != 0);
   BeaconMapCheck again_verdict;
   const std::optional<BeaconMap> back =
       BeaconMap::from(dds::from_msg(dds::to_msg(*map, m.frame_id())), &again_verdict);
-  check(back.has_value() && back->size() == map->size());
+  check(back.has_value() && back->size() == map->size() && *back == *map);
   for (const auto& b : map->beacons()) {
     const Beacon* again = back->find(b.id);
     check(again && again->group == b.group);

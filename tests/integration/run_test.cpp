@@ -185,6 +185,21 @@ TEST_F(Run, UkfFusesLaserAndAnonymousBeaconsAcrossProcesses) {
   EXPECT_EQ(out.find("out_of_range_tof"), std::string::npos) << out;
 }
 
+// Seed 003 through DDS: the gateway's BeaconMap carries the LRULPSs' beacons in their own frames
+// (frame GROUP); the decoder decodes their ranges, and the localizer, holding no calibration,
+// refuses each as uncalibrated_beacon (none as unknown_beacon: the map that crossed the bus has
+// them), while it localizes on GRULPS 1.
+TEST_F(Run, LocallyReferencedBeaconsCrossTheBusInTheirFramesAndAreNotUsedUncalibrated) {
+  const auto [code, out] = beaconloc({"run", "--duration-s", "25", "--scenario",
+                                      kSource + "/examples/scenarios/seed003_scan.yaml", "--out", dir_});
+  ASSERT_EQ(code, 0) << out;
+  EXPECT_NE(out.find("range.uncalibrated_beacon"), std::string::npos) << out;
+  EXPECT_EQ(out.find("unknown_beacon"), std::string::npos) << out;
+  const std::string beacons = read(dir_ + "/beacons.csv");
+  EXPECT_NE(beacons.find(",3,group\n"), std::string::npos) << beacons;
+  EXPECT_NE(beacons.find(",1,map\n"), std::string::npos) << beacons;
+}
+
 // Seed 002 through DDS, one process per participant: beacons without a radio message, so the
 // gateway publishes pulse arrivals (beaconloc/pulse_arrival) straight to kleeman_iekf, which names
 // the beacons by their firing order; no decoder is started.

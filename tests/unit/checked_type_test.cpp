@@ -84,6 +84,20 @@ TEST(CheckedType, APulseMarkTheIdlDoesNotDefineIsRefusedNotReadAsADoubleBurst) {
   }
 }
 
+TEST(CheckedType, ABeaconFrameTheIdlDoesNotDefineIsRefusedNotReadAsAMapPosition) {
+  msg::BeaconMap m;
+  m.frame_id("map");
+  m.beacons().resize(2);
+  for (auto f : {msg::BEACON_FRAME_MAP, msg::BEACON_FRAME_GROUP}) {
+    m.beacons()[1].frame(f);
+    EXPECT_EQ(round_trip<msg::BeaconMapPubSubType>(m), std::make_pair(true, std::uint64_t{0}));
+  }
+  for (std::uint32_t v : {std::uint32_t{2}, kUndefined[1], kUndefined[3]}) {
+    m.beacons()[1].frame(static_cast<msg::BeaconFrame>(v));
+    EXPECT_EQ(round_trip<msg::BeaconMapPubSubType>(m), std::make_pair(false, std::uint64_t{1})) << v;
+  }
+}
+
 TEST(CheckedType, AnEstimatorStateValueNameThatBreaksACsvCellIsRefused) {
   msg::EstimatorState s;
   s.robot_id("r");

@@ -44,8 +44,8 @@ std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t s
 OfflineStack::OfflineStack(const sim::Scenario& scenario, const std::string& estimator,
                            const std::map<std::string, double>& parameters)
     : localizer(estimator, config_for(scenario, parameters)), decoder(decoder_config_for(scenario)) {
-  localizer.set_beacon_map(BeaconMap(scenario.beacons));
-  decoder.set_beacon_map(BeaconMap(scenario.beacons));
+  localizer.set_beacon_map(BeaconMap(scenario.beacon_list()));
+  decoder.set_beacon_map(BeaconMap(scenario.beacon_list()));
 }
 
 std::optional<EstimatorInput> estimator_input(const std::string& robot_id, const SourceEvent& e,

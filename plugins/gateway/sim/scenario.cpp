@@ -29,6 +29,20 @@ Scenario default_scenario() {
   return s;
 }
 
+BeaconList Scenario::beacon_list() const {
+  BeaconList list;
+  for (const Beacon& b : beacons) {
+    const auto frame = local_group_frames_map.find(b.group);
+    if (frame == local_group_frames_map.end()) {
+      list.map_frame.push_back(b);
+      continue;
+    }
+    const Pose2 in_group = between(frame->second, {b.position_map_m.x(), b.position_map_m.y(), 0.0});
+    list.group_frame.push_back({b.id, b.group, {in_group.x(), in_group.y(), b.position_map_m.z()}});
+  }
+  return list;
+}
+
 bool Faults::silences(std::uint32_t beacon_id, StampNs fire_ns) const {
   const auto dead = beacon_dies_at_ns.find(beacon_id);
   if (dead != beacon_dies_at_ns.end() && fire_ns >= dead->second) return true;

@@ -48,7 +48,14 @@ struct Scenario {
   // path error from 20 s); the accuracy commands' settling time counts as well.
   double score_from_s = 0.0;
 
-  std::vector<Beacon> beacons;
+  std::vector<Beacon> beacons;  // every beacon at its true map position (the simulator's truth)
+  // Seed 003: the locally referenced beacon groups, each with its frame's true pose in the map
+  // (x, y, yaw). Their beacons are given to the participants in their group's frame only
+  // (beacon_list()); every other group is globally referenced.
+  std::map<std::uint32_t, Pose2> local_group_frames_map;
+  // The beacon map the gateway publishes (and the offline runs hand over): the globally
+  // referenced beacons at their map positions, the locally referenced ones in their group's frame.
+  BeaconList beacon_list() const;
   // Beacon system.
   std::vector<std::uint32_t> firing_order;           // beacon ids, one per slot, cycled
   StampNs slot_period_ns = 200 * kNsPerMillisecond;  // 5 Hz firing slots

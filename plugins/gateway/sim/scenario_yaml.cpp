@@ -154,6 +154,34 @@ void read_beacons(const Section& root, Scenario& sc) {
   }
 }
 
+// Seed 003's beacon groups: `groups: [{id, referenced: global | local, frame_pose_m: [x, y,
+// yaw_deg]}]`, a local group's frame pose being the truth the participants are not told. A group
+// not listed is globally referenced.
+void read_groups(const Section& root, Scenario& sc) {
+  if (!root.has("groups")) return;
+  const YAML::Node list = root.node("groups");
+  if (!list.IsSequence()) root.fail("groups", "must be a list of groups", list);
+  std::set<std::uint32_t> used, listed;
+  for (const auto& b : sc.beacons) used.insert(b.group);
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const Section g(list[i], "groups[" + std::to_string(i) + "]", root.origin(), {"id", "referenced", "frame_pose_m"});
+    const auto id = g.required<std::uint32_t>("id");
+    if (id == 0) g.fail(g.join("id"), "is 0, the group of a site with one group: it has no frame of its own", list[i]);
+    if (!used.count(id)) g.fail(g.join("id"), "is not the group of any beacon", list[i]);
+    if (!listed.insert(id).second) g.fail(g.join("id"), "repeats an earlier group", list[i]);
+    const auto referenced = g.required<std::string>("referenced");
+    if (referenced == "global") {
+      if (g.has("frame_pose_m")) g.fail(g.join("frame_pose_m"), "is for a locally referenced group only", list[i]);
+    } else if (referenced == "local") {
+      if (!g.has("frame_pose_m")) g.fail(g.join("frame_pose_m"), "is required for a locally referenced group", list[i]);
+      const Eigen::Vector3d pose = vec3(g, g.node("frame_pose_m"), g.join("frame_pose_m"), kMaxMapCoordinateM);
+      sc.local_group_frames_map[id] = Pose2(pose.x(), pose.y(), wrap_angle_rad(pose.z() * M_PI / 180.0));
+    } else {
+      g.fail(g.join("referenced"), "must be global or local", list[i]);
+    }
+  }
+}
+
 void read_beacon_system(const Section& root, Scenario& sc) {
   for (const auto& b : sc.beacons) sc.firing_order.push_back(b.id);
   if (!root.has("beacon_system")) return;
@@ -360,8 +388,8 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
     throw ScenarioError(e.what());
   }
   const Section root(doc, "", origin,
-                     {"name", "description", "seed", "duration_s", "score_from_s", "beacons", "beacon_system",
-                      "robot", "trajectory", "map", "laser"});
+                     {"name", "description", "seed", "duration_s", "score_from_s", "beacons", "groups",
+                      "beacon_system", "robot", "trajectory", "map", "laser"});
   Scenario sc;
   sc.name = root.required<std::string>("name");
   sc.description = root.get<std::string>("description", "");
@@ -369,6 +397,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
   sc.duration_s = root.number("duration_s", 20.0, 0.01, kMaxDurationS);
   sc.score_from_s = root.number("score_from_s", 0.0, 0.0, sc.duration_s);
   read_beacons(root, sc);
+  read_groups(root, sc);
   read_beacon_system(root, sc);
   read_robot(root, sc);
   read_trajectory(root, sc);

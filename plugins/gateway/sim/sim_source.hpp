@@ -20,7 +20,7 @@ class SimSource final : public Source {
   void advance(StampNs until_ns, std::vector<SourceEvent>& out) override;
   bool exhausted() const override { return false; }
   bool finite() const override { return false; }  // a scenario can be run for any duration
-  BeaconMap beacon_map() const override { return BeaconMap(scenario_.beacons); }
+  BeaconMap beacon_map() const override { return BeaconMap(scenario_.beacon_list()); }
   ReceiverArray receivers() const override { return scenario_.receivers; }
   StampNs first_stamp_ns() const override { return 0; }
   StampNs last_stamp_ns() const override { return s_to_ns(scenario_.duration_s); }

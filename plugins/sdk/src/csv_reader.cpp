@@ -94,35 +94,49 @@ NumberError CsvReader::read_id(const std::string& column, std::uint32_t& out, st
 
 BeaconMap load_beacon_map_csv(const std::string& path) {
   CsvReader csv(path, {"beacon_id", "x_m", "y_m", "z_m"});
-  std::vector<Beacon> beacons;
+  const bool has_group = csv.has_column("group"), has_frame = csv.has_column("frame");
+  BeaconList beacons;
   std::set<std::uint32_t> ids;
   while (csv.next()) {
-    Beacon b;
+    std::uint32_t id = 0, group = 0;
     double x = 0, y = 0, z = 0;
     std::string problem;
     if (!csv.complete()) throw CsvError(csv.where() + ": malformed beacon row: " + csv.cell_count_problem());
-    if (csv.read_id("beacon_id", b.id, problem) != NumberError::kNone ||
+    if (csv.read_id("beacon_id", id, problem) != NumberError::kNone ||
         csv.read("x_m", x, -kMaxMapCoordinateM, kMaxMapCoordinateM, problem) != NumberError::kNone ||
         csv.read("y_m", y, -kMaxMapCoordinateM, kMaxMapCoordinateM, problem) != NumberError::kNone ||
-        csv.read("z_m", z, -kMaxMapCoordinateM, kMaxMapCoordinateM, problem) != NumberError::kNone) {
+        csv.read("z_m", z, -kMaxMapCoordinateM, kMaxMapCoordinateM, problem) != NumberError::kNone ||
+        (has_group && csv.read_id("group", group, problem) != NumberError::kNone)) {
       throw CsvError(csv.where() + ": malformed beacon row: " + problem);
     }
-    if (!ids.insert(b.id).second)
-      throw CsvError(csv.where() + ": beacon id " + std::to_string(b.id) + " repeated");
-    b.position_map_m = {x, y, z};
-    beacons.push_back(b);
+    if (!ids.insert(id).second)
+      throw CsvError(csv.where() + ": beacon id " + std::to_string(id) + " repeated");
+    const std::string frame = has_frame ? csv.cell("frame") : "map";
+    if (frame == "map") {
+      beacons.map_frame.push_back({id, {x, y, z}, group});
+    } else if (frame == "group") {
+      beacons.group_frame.push_back({id, group, {x, y, z}});  // group 0: check_beacons refuses it below
+    } else {
+      throw CsvError(csv.where() + ": malformed beacon row: frame '" + frame + "' is neither map nor group");
+    }
   }
-  if (beacons.empty()) throw CsvError(path + ": no beacons");
+  if (beacons.map_frame.empty() && beacons.group_frame.empty()) throw CsvError(path + ": no beacons");
+  const BeaconMapCheck check = check_beacons(beacons);
+  if (!check.ok()) throw CsvError(path + ": " + check.describe());
   return BeaconMap(beacons);
 }
 
 void write_beacon_map_csv(const std::string& path, const BeaconMap& map) {
   std::ofstream out(path);
   if (!out) throw CsvError("cannot write '" + path + "'");
-  out << "beacon_id,x_m,y_m,z_m\n" << std::setprecision(10);
+  out << "beacon_id,x_m,y_m,z_m,group,frame\n" << std::setprecision(10);
   for (const auto& b : map.beacons()) {
-    out << b.id << ',' << b.position_map_m.x() << ',' << b.position_map_m.y() << ',' << b.position_map_m.z()
-        << '\n';
+    out << b.id << ',' << b.position_map_m.x() << ',' << b.position_map_m.y() << ',' << b.position_map_m.z() << ','
+        << b.group << ",map\n";
+  }
+  for (const auto& b : map.local_beacons()) {
+    out << b.id << ',' << b.position_group_m.x() << ',' << b.position_group_m.y() << ','
+        << b.position_group_m.z() << ',' << b.group << ",group\n";
   }
   if (!out.flush()) throw CsvError("writing '" + path + "' failed");
 }

@@ -166,7 +166,9 @@ InputResult check_range(const RangeMeasurement& r, const BeaconMap& map, std::si
   if (InputResult numbers = check_range_numbers(r); !numbers.accepted) return numbers;
   if (r.beacon_id == kBeaconUnidentified) return InputResult::rejected(Rejection::kUnassociatedRange);
   if (map.empty()) return InputResult::rejected(Rejection::kNoBeaconMap);
-  if (!map.find(r.beacon_id)) return InputResult::rejected(Rejection::kUnknownBeacon);
+  if (!map.find(r.beacon_id)) {
+    return InputResult::rejected(map.find_local(r.beacon_id) ? Rejection::kUncalibratedBeacon : Rejection::kUnknownBeacon);
+  }
   if (r.receiver_id >= receiver_count) return InputResult::rejected(Rejection::kUnknownReceiver);
   return InputResult::ok();
 }

@@ -20,6 +20,7 @@ const char* to_string(Rejection r) {
     case Rejection::kUnassociatedRange: return "unassociated_range";
     case Rejection::kNoBeaconMap: return "no_beacon_map";
     case Rejection::kUnknownBeacon: return "unknown_beacon";
+    case Rejection::kUncalibratedBeacon: return "uncalibrated_beacon";
     case Rejection::kUnknownReceiver: return "unknown_receiver";
     case Rejection::kStaleRange: return "stale_range";
     case Rejection::kRangesWithoutOdometry: return "ranges_without_odometry";

@@ -123,7 +123,11 @@ void KleemanIekf::set_beacon_map(const BeaconMap& map) {
                                       std::abs(extent.min().z() - receivers_.receiver_height_m)));
   max_flight_s_ = map.empty() ? 0.0 : span.norm() / kSlowestSoundMps + kEchoAllowanceS;
   const auto marked = static_cast<std::uint32_t>(params_.marked_beacon_id);
-  if (std::find(order_.begin(), order_.end(), marked) == order_.end()) {
+  if (map.local_size() > 0) {
+    // Seed 003's locally referenced beacons fire in the cycle too, but where they are is unknown:
+    // neither their pulses nor the slots' flight bound could be modelled.
+    map_problem_ = std::to_string(map.local_size()) + " locally referenced beacon(s): their positions are not known";
+  } else if (std::find(order_.begin(), order_.end(), marked) == order_.end()) {
     map_problem_ = "the marked beacon " + std::to_string(marked) + " is not in the beacon map";
   } else if (order_.size() < 3) {
     map_problem_ = std::to_string(order_.size()) + " beacon(s): a position and a firing time need three";

@@ -104,7 +104,12 @@ InputResult UkfLrf::update(const RangeMeasurement& r) {
   if (InputResult numbers = check_range_numbers(r); !numbers.accepted) return numbers;
   if (mode_ == Mode::kLaserOnly) return InputResult::rejected(Rejection::kBeaconsUnused);
   if (r.receiver_id != 0) return InputResult::rejected(Rejection::kUnknownReceiver);
-  if (map().empty()) return InputResult::rejected(Rejection::kNoBeaconMap);
+  if (map().size() == 0) return InputResult::rejected(Rejection::kNoBeaconMap);  // none with a map position
+  // The id is not used to associate, but a beacon whose map position is not known (seed 003's
+  // uncalibrated LRULPS) must not be taken for a known one it happens to be near.
+  if (r.beacon_id != kBeaconUnidentified && map().find_local(r.beacon_id)) {
+    return InputResult::rejected(Rejection::kUncalibratedBeacon);
+  }
   if (!has_pose()) return InputResult::rejected(Rejection::kNoInitialPose);
   // Anonymous or not, the range is associated (Table 2): the id a beacon may announce is not
   // used, as in the paper (Sec. 4.1). It is fused on its own, not held until the cycle of four

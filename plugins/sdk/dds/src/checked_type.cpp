@@ -34,6 +34,15 @@ bool defined(msg::PulseMark m) {
   return false;
 }
 
+bool defined(msg::BeaconFrame f) {
+  switch (f) {
+    case msg::BEACON_FRAME_MAP:
+    case msg::BEACON_FRAME_GROUP:
+      return true;
+  }
+  return false;
+}
+
 bool defined(msg::RangeAssociation a) {
   switch (a) {
     case msg::RANGE_ASSOCIATION_BY_ID:
@@ -90,7 +99,10 @@ bool well_formed(const msg::EstimatorState& m) {
 
 bool well_formed(const msg::InitialPose& m) { return identifier(m.robot_id()); }
 
-bool well_formed(const msg::BeaconMap& m) { return printable(m.frame_id()); }
+bool well_formed(const msg::BeaconMap& m) {
+  return printable(m.frame_id()) &&
+         std::all_of(m.beacons().begin(), m.beacons().end(), [](const msg::Beacon& b) { return defined(b.frame()); });
+}
 
 bool well_formed(const msg::Diagnostics& m) {
   if (!identifier(m.participant()) || !printable(m.message()) || !defined(m.status())) return false;

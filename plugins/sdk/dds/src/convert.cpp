@@ -127,26 +127,45 @@ msg::LaserScan to_msg(const std::string& robot_id, const LaserScanSample& s) {
   return m;
 }
 
-std::vector<Beacon> from_msg(const msg::BeaconMap& m) {
-  std::vector<Beacon> beacons;
-  beacons.reserve(m.beacons().size());
+BeaconList from_msg(const msg::BeaconMap& m) {
+  BeaconList beacons;
   for (const auto& b : m.beacons()) {
-    beacons.push_back({b.id(), {b.x_m(), b.y_m(), b.z_m()}, b.group()});
+    const Eigen::Vector3d position_m(b.x_m(), b.y_m(), b.z_m());
+    switch (b.frame()) {  // a frame the IDL does not define never gets here (checked_type.hpp)
+      case msg::BEACON_FRAME_GROUP:
+        beacons.group_frame.push_back({b.id(), b.group(), position_m});
+        break;
+      case msg::BEACON_FRAME_MAP:
+        beacons.map_frame.push_back({b.id(), position_m, b.group()});
+        break;
+    }
   }
   return beacons;
 }
 
+namespace {
+
+msg::Beacon beacon_msg(std::uint32_t id, const Eigen::Vector3d& position_m, std::uint32_t group, msg::BeaconFrame frame) {
+  msg::Beacon mb;
+  mb.id(id);
+  mb.x_m(position_m.x());
+  mb.y_m(position_m.y());
+  mb.z_m(position_m.z());
+  mb.group(group);
+  mb.frame(frame);
+  return mb;
+}
+
+}  // namespace
+
 msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id) {
   msg::BeaconMap m;
   m.frame_id(frame_id);
-  for (const auto& b : map.beacons()) {
-    msg::Beacon mb;
-    mb.id(b.id);
-    mb.x_m(b.position_map_m.x());
-    mb.y_m(b.position_map_m.y());
-    mb.z_m(b.position_map_m.z());
-    mb.group(b.group);
-    m.beacons().push_back(mb);
+  for (const Beacon& b : map.beacons()) {
+    m.beacons().push_back(beacon_msg(b.id, b.position_map_m, b.group, msg::BEACON_FRAME_MAP));
+  }
+  for (const LocalBeacon& b : map.local_beacons()) {
+    m.beacons().push_back(beacon_msg(b.id, b.position_group_m, b.group, msg::BEACON_FRAME_GROUP));
   }
   return m;
 }

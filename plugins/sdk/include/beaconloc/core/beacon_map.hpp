@@ -5,6 +5,12 @@
 // is not a finite number within kMaxMapCoordinateM (core/limits.hpp) is refused whole, with the
 // reason and the beacon that caused it; nothing is "repaired" (the first of two ids kept, a NaN
 // used).
+//
+// Seed 003's sites have two kinds of beacon group (ULPS): globally referenced ones, whose beacons'
+// map positions are known (Beacon), and locally referenced ones, whose beacons' positions are known
+// only in the group's own frame (LocalBeacon) until a calibration finds the group's transform to
+// the map. A map holds both; find() gives only beacons with a map position, so that no estimator
+// uses a beacon never calibrated as if it were known (a range to one is uncalibrated_beacon).
 #include <Eigen/Core>
 #include <cstdint>
 #include <map>
@@ -22,7 +28,27 @@ namespace beaconloc {
 struct Beacon {
   std::uint32_t id = 0;
   Eigen::Vector3d position_map_m = Eigen::Vector3d::Zero();
-  std::uint32_t group = 0;
+  std::uint32_t group = 0;  // its beacon group (ULPS, seed 003); 0 where the site is one group
+};
+
+// A beacon of a locally referenced group: its position in the group's own frame (x, y in the
+// group's plane, z its height as in the map), never a map position.
+struct LocalBeacon {
+  std::uint32_t id = 0;
+  std::uint32_t group = 0;  // never 0: the group names the frame
+  Eigen::Vector3d position_group_m = Eigen::Vector3d::Zero();
+};
+
+// What a map is made from, as a source lists it. A list of Beacons alone is a map whose beacons
+// are all in the map frame.
+struct BeaconList {
+  BeaconList() = default;
+  BeaconList(std::vector<Beacon> map_frame_beacons)  // NOLINT(google-explicit-constructor): the common case
+      : map_frame(std::move(map_frame_beacons)) {}
+  BeaconList(std::vector<Beacon> map_frame_beacons, std::vector<LocalBeacon> group_frame_beacons)
+      : map_frame(std::move(map_frame_beacons)), group_frame(std::move(group_frame_beacons)) {}
+  std::vector<Beacon> map_frame;
+  std::vector<LocalBeacon> group_frame;
 };
 
 // More beacons than any site has (a slot every 200 ms would take 13 min to fire them all): a
@@ -37,6 +63,8 @@ enum class BeaconMapProblem {
   kDuplicateId,         // two beacons with one id
   kNonFinitePosition,   // NaN or infinity in a coordinate
   kPositionOutOfRange,  // a coordinate beyond kMaxMapCoordinateM
+  kLocalWithoutGroup,   // a locally referenced beacon in group 0: no frame to be local to
+  kGroupBothKinds,      // a group with beacons in the map frame and beacons in its own frame
 };
 // Stable snake_case names (Diagnostics reasons: beacon_map.<name>).
 const char* to_string(BeaconMapProblem problem);
@@ -47,7 +75,7 @@ struct BeaconMapCheck {
   bool ok() const { return problem == BeaconMapProblem::kNone; }
   std::string describe() const;  // "beacon 4: duplicate_id"
 };
-BeaconMapCheck check_beacons(const std::vector<Beacon>& beacons);
+BeaconMapCheck check_beacons(const BeaconList& beacons);
 
 // Thrown by BeaconMap(beacons) for a list that check_beacons refuses.
 class InvalidBeaconMap : public std::invalid_argument {
@@ -64,16 +92,29 @@ class BeaconMap {
  public:
   BeaconMap() = default;
   // Throws InvalidBeaconMap unless check_beacons(beacons).ok().
-  explicit BeaconMap(const std::vector<Beacon>& beacons);
+  explicit BeaconMap(const BeaconList& beacons);
+  explicit BeaconMap(const std::vector<Beacon>& beacons) : BeaconMap(BeaconList(beacons)) {}
   // The map, or nullopt with the reason in *check: for input that may be bad (the bus).
-  static std::optional<BeaconMap> from(const std::vector<Beacon>& beacons, BeaconMapCheck* check);
+  static std::optional<BeaconMap> from(const BeaconList& beacons, BeaconMapCheck* check);
 
+  // A beacon whose map position is known; nullptr for one only locally referenced.
   const Beacon* find(std::uint32_t id) const {
     auto it = beacons_.find(id);
     return it == beacons_.end() ? nullptr : &it->second;
   }
-  bool empty() const { return beacons_.empty(); }
-  std::size_t size() const { return beacons_.size(); }
+  // A locally referenced beacon (its position in its group's frame only).
+  const LocalBeacon* find_local(std::uint32_t id) const {
+    auto it = local_.find(id);
+    return it == local_.end() ? nullptr : &it->second;
+  }
+  bool empty() const { return beacons_.empty() && local_.empty(); }
+  std::size_t size() const { return beacons_.size(); }  // beacons with a map position
+  std::size_t local_size() const { return local_.size(); }
+  std::vector<LocalBeacon> local_beacons() const {
+    std::vector<LocalBeacon> out;
+    for (const auto& [id, b] : local_) out.push_back(b);
+    return out;
+  }
   // f(beacon) for every beacon in id order, without the copy beacons() makes.
   template <class F>
   void for_each(F&& f) const {
@@ -84,17 +125,19 @@ class BeaconMap {
     for (const auto& [id, b] : beacons_) out.push_back(b);
     return out;
   }
-  // Same beacons at the same positions in the same groups (a gateway that restarts publishes
-  // the map again: that is no new map).
+  BeaconList list() const { return {beacons(), local_beacons()}; }
+  // Same beacons at the same positions in the same groups and frames (a gateway that restarts
+  // publishes the map again: that is no new map).
   bool operator==(const BeaconMap& other) const;
   bool operator!=(const BeaconMap& other) const { return !(*this == other); }
 
  private:
-  std::map<std::uint32_t, Beacon> beacons_;  // ordered: deterministic iteration
+  std::map<std::uint32_t, Beacon> beacons_;     // ordered: deterministic iteration
+  std::map<std::uint32_t, LocalBeacon> local_;  // locally referenced, by id
 };
 
 // How every participant takes a map from the bus: the map, or nullopt with the refusal counted
 // in `counts` as beacon_map.<reason> (the caller keeps the map it has).
-std::optional<BeaconMap> counted_beacon_map(const std::vector<Beacon>& beacons, RejectionCounter& counts);
+std::optional<BeaconMap> counted_beacon_map(const BeaconList& beacons, RejectionCounter& counts);
 
 }  // namespace beaconloc

@@ -60,9 +60,11 @@ class CsvReader {
 
 std::vector<std::string> split_csv_line(const std::string& line);
 
-// beacon_id,x_m,y_m,z_m. Throws CsvError naming the file and line of a malformed row (the
-// column and the cell: a position must lie within kMaxMapCoordinateM, core/limits.hpp), a
-// repeated id, or a file without beacons.
+// beacon_id,x_m,y_m,z_m, optional group (its beacon group, 0 by default) and frame (map, the
+// default; or group: a locally referenced beacon, x, y in its group's frame, seed 003). Throws
+// CsvError naming the file and line of a malformed row (the column and the cell: a position must
+// lie within kMaxMapCoordinateM, core/limits.hpp), a repeated id, a frame neither map nor group,
+// a local beacon without a group, a group of both kinds, or a file without beacons.
 BeaconMap load_beacon_map_csv(const std::string& path);
 void write_beacon_map_csv(const std::string& path, const BeaconMap& map);
 

@@ -31,6 +31,7 @@ enum class Rejection : std::uint8_t {
   kUnassociatedRange,  // anonymous, to an estimator that needs identified beacons
   kNoBeaconMap,
   kUnknownBeacon,
+  kUncalibratedBeacon,  // locally referenced (seed 003): no map position until calibrated
   kUnknownReceiver,
   kStaleRange,
   kRangesWithoutOdometry,

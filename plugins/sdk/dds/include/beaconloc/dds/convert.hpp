@@ -26,9 +26,10 @@ RangeMeasurement from_msg(const msg::BeaconRange& m);
 LaserScanSample from_msg(const msg::LaserScan& m);
 msg::LaserScan to_msg(const std::string& robot_id, const LaserScanSample& s);
 
-// The beacons of a BeaconMap sample as sent, unchecked: the core's set_beacon_map checks them
-// (check_beacons) and counts a refused map as beacon_map.<reason>.
-std::vector<Beacon> from_msg(const msg::BeaconMap& m);
+// The beacons of a BeaconMap sample as sent, unchecked, each in the list of its frame: the core's
+// set_beacon_map checks them (check_beacons) and counts a refused map as beacon_map.<reason>. (A
+// frame the IDL does not define never gets here: checked_type.hpp refuses the sample.)
+BeaconList from_msg(const msg::BeaconMap& m);
 msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id);
 
 msg::PoseEstimate to_msg(const std::string& robot_id, const PoseEstimate& estimate,
