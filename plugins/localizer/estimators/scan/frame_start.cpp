@@ -1,6 +1,7 @@
 #include "scan/frame_start.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "beaconloc/core/models/diff_drive_motion.hpp"
 
@@ -12,7 +13,12 @@ Eigen::Vector2d across(const Eigen::Vector2d& v) { return Eigen::Vector2d(-v.y()
 
 }  // namespace
 
-FrameStart::FrameStart(const FrameStartSettings& settings) : settings_(settings) {}
+FrameStart::FrameStart(const FrameStartSettings& settings) : settings_(settings) {
+  if (!(settings.heading_baseline_m > 0.0) || !std::isfinite(settings.heading_baseline_m) ||
+      !(settings.max_disagreement_sigma > 0.0)) {
+    throw std::invalid_argument("FrameStart: heading_baseline_m and max_disagreement_sigma must be finite and > 0");
+  }
+}
 
 PredictResult FrameStart::predict(const OdometrySample& o, double dt_s, double wheel_variance_floor_m2ps2) {
   if (!first_) return {};

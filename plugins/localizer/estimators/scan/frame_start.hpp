@@ -14,8 +14,10 @@
 namespace beaconloc::scan {
 
 struct FrameStartSettings {
-  // The fixes must be this far apart: the heading's sigma is about the fixes' sigma (3-7 cm under
-  // a 1 m group at 3.5 m) times 1.4 over it. Not in the paper ("a second different MR position").
+  // The robot must have moved this far (odometry) from the first fix before a second gives the
+  // heading (and the fixes' chord be at least half of it): the heading's sigma is about the fixes'
+  // sigma (1-5 cm under a 1 m group at 3.5 m) times 1.4 over it. Not in the paper ("a second
+  // different MR position"). Must be > 0 (FrameStart throws std::invalid_argument otherwise).
   double heading_baseline_m = 1.0;
   // Two fixes whose distance the odometry contradicts by more than this many sigmas: the older
   // is dropped (an echo moved it) and the newer starts again.
@@ -35,7 +37,7 @@ enum class FrameStartWait : std::uint8_t {
 class FrameStart {
  public:
   explicit FrameStart(const FrameStartSettings& settings);
-  // The odometry since the first fix (ignored before it).
+  // The odometry since the first fix (before it nothing is tracked, and kApplied is returned).
   PredictResult predict(const OdometrySample& odometry, double dt_s, double wheel_variance_floor_m2ps2);
   // A new fix of the group (ok() only): the frame's first pose once two fixes are far enough apart.
   std::optional<FrameBelief> add_fix(const GroupFix& fix);

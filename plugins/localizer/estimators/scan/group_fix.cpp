@@ -1,7 +1,10 @@
 #include "scan/group_fix.hpp"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
+
+#include "beaconloc/core/chi_square.hpp"
 
 #include "beaconloc/core/models/range_difference_model.hpp"
 #include "beaconloc/core/models/range_model.hpp"
@@ -105,7 +108,10 @@ GroupFix solve_group_fix(const GroupMeasurements& m, const GroupFixSettings& set
       const double chi2 = at.residual.dot(ra.solve(at.residual));
       fix.residual_rms_sigma = std::sqrt(chi2 / static_cast<double>(at.residual.size()));
       if (!fix.covariance_m2.allFinite() || !p.allFinite()) return failed(GroupFixFailure::kNonFinite, fix.iterations);
-      if (fix.residual_rms_sigma > settings.max_residual_rms_sigma) {
+      // m residuals, 2 unknowns fitted: m - 2 degrees of freedom (at least 1: three ranges or
+      // three differences at the least).
+      const int dof = std::max(1, static_cast<int>(at.residual.size()) - 2);
+      if (!(chi2 <= chi_square_quantile_999(dof))) {
         fix.failure = GroupFixFailure::kResidualTooLarge;
       }
       return fix;

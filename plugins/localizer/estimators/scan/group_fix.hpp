@@ -19,7 +19,8 @@ enum class GroupFixFailure : std::uint8_t {
   kNonFinite,         // a beacon, a range or the result not finite
   kSingular,          // the normal equations could not be solved (beacons in a line under the robot)
   kNotConverged,      // no step under the tolerance within the iterations
-  kResidualTooLarge,  // the fix does not explain its measurements (an echo, a wrong beacon)
+  kResidualTooLarge,  // the fix does not explain its measurements (an echo, a wrong beacon): the
+                      // whitened residuals' chi-square above its 99.9 % quantile for m - 2 dof
 };
 const char* to_string(GroupFixFailure failure);
 
@@ -34,14 +35,13 @@ struct GroupMeasurements {
 struct GroupFixSettings {
   int max_iterations = 50;  // Gauss-Newton converges slowly where the residuals are large (an echo)
   double tolerance_m = 1e-6;
-  double max_residual_rms_sigma = 4.0;
 };
 
 struct GroupFix {
   GroupFixFailure failure = GroupFixFailure::kNone;
   Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
   Eigen::Matrix2d covariance_m2 = Eigen::Matrix2d::Identity();  // (J^T R^-1 J)^-1 at the fix
-  double residual_rms_sigma = 0.0;  // whitened residuals' RMS
+  double residual_rms_sigma = 0.0;  // whitened residuals' RMS (for people; the gate is on their chi-square)
   int iterations = 0;
   bool ok() const { return failure == GroupFixFailure::kNone; }
 };

@@ -129,7 +129,7 @@ TEST(FrameFilter, EveryFilterTracksTheRobotThroughAGroupInBothGeometries) {
   for (const Geometry geometry : {Geometry::kSpherical, Geometry::kHyperbolic}) {
     for (const FilterKind kind : {FilterKind::kEkf, FilterKind::kUkf, FilterKind::kHInfinity}) {
       double p = 0.0, h = 0.0, nees = 0.0;
-      constexpr int kSeeds = 10;
+      constexpr int kSeeds = 4;  // 4 seeds: 20 s under ASan
       for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
         const RunFigures f = drive(kind, geometry, seed);
         ASSERT_TRUE(f.started) << to_string(kind) << " seed " << seed;
@@ -140,9 +140,10 @@ TEST(FrameFilter, EveryFilterTracksTheRobotThroughAGroupInBothGeometries) {
       }
       std::printf("%s %s: position RMS %.4f m, heading RMS %.4f rad, mean NEES %.2f\n",
                   geometry == Geometry::kSpherical ? "spherical" : "hyperbolic", to_string(kind), p, h, nees);
-      // Measured (10 seeds): 0.010 m / 0.019 rad spherical, 0.015 m / 0.027 rad hyperbolic, the
-      // three filters within 1 mm of each other; mean NEES 3.7 for 3 dof (a little overconfident,
-      // mostly in the first seconds, while the heading from two fixes settles).
+      // Measured (these 4 seeds): 0.012 m / 0.021 rad spherical, 0.016 m / 0.033 rad hyperbolic,
+      // the three filters within 1 mm of each other; mean NEES 4.1 for 3 dof: overconfident by a
+      // third, mostly in the first seconds, while the heading from two fixes settles (an open
+      // point: with 10 seeds it was 3.7).
       const double bound_m = geometry == Geometry::kSpherical ? 0.02 : 0.03;
       EXPECT_LT(p, bound_m) << to_string(kind);
       EXPECT_LT(h, 0.05) << to_string(kind);
