@@ -1,9 +1,11 @@
 #include "scan/scan_estimator.hpp"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
+#include "beaconloc/core/chi_square.hpp"
 #include "beaconloc/core/estimator_parameters.hpp"
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/limits.hpp"
@@ -37,6 +39,8 @@ ScanParameters ScanParameters::from(const EstimatorConfig& c) {
   p.epoch_window_s = in.real("epoch_window_s", p.epoch_window_s, ranges::kDataDurationS);
   p.overlap_end_s = in.real("overlap_end_s", p.overlap_end_s, ranges::kDataDurationS);
   p.max_odometry_gap_s = in.real("max_odometry_gap_s", p.max_odometry_gap_s, ranges::kDataDurationS);
+  p.inverse_trajectory = in.flag("inverse_trajectory", p.inverse_trajectory);
+  p.inverse_after_s = in.real("inverse_after_s", p.inverse_after_s, ParameterRange::above(0.0, 600.0));
   in.finish();
   return p;
 }
@@ -44,7 +48,11 @@ ScanParameters ScanParameters::from(const EstimatorConfig& c) {
 ScanEstimator::ScanEstimator(const EstimatorConfig& config) : ScanEstimator(config, ScanParameters::from(config)) {}
 
 ScanEstimator::ScanEstimator(const EstimatorConfig& config, const ScanParameters& params)
-    : EstimatorBase(params.max_odometry_gap_s), receivers_(config.receivers), params_(params), global_(params) {
+    : EstimatorBase(params.max_odometry_gap_s),
+      config_(config),
+      receivers_(config.receivers),
+      params_(params),
+      global_(params) {
   // Sec. 3.2: one receiver (Sec. 5: a microphone on the robot); its fixes are its own position.
   if (receivers_.size() != 1) throw std::invalid_argument("scan: the robot must have exactly one receiver (seed 003)");
   waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(beacons_for_a_fix(params_.geometry)), {}};
@@ -76,15 +84,20 @@ InputResult ScanEstimator::predict(const OdometrySample& o) {
       predict_diff_drive(odometry_pose_, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps, o.wheel_base_m, step.dt_s)
           .pose;
   const auto advance_frame = [&](Frame& f) {
+    if (f.started && f.relocating) {
+      if (const PredictResult r = f.start.predict(o, step.dt_s, floor); !r.applied()) return r;
+    }
     return f.started ? f.filter.predict(o, step.dt_s, floor) : f.start.predict(o, step.dt_s, floor);
   };
   if (const PredictResult r = advance_frame(global_); !r.applied()) return InputResult::of(r.outcome);
   for (auto& [group, local] : local_) {
     if (const PredictResult r = advance_frame(local.frame); !r.applied()) return InputResult::of(r.outcome);
   }
+  record(o);
   const StampNs now = *now_ns();
   close_epochs(now, false);
   finish_overlaps(now);
+  maybe_run_inverse_trajectory(now, false);
   return InputResult::ok();
 }
 
@@ -115,6 +128,7 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   Epoch& epoch = open_epochs_[group];
   epoch.group = group;
   if (epoch.ranges.size() >= kMaxBeacons) return InputResult::rejected(Rejection::kImplausibleRange);
+  record(r);
   std::optional<double> rate_mps;
   if (auto last = last_range_.find(r.beacon_id); last != last_range_.end()) {
     const StampNs dt_ns = r.stamp_ns - last->second.first;
@@ -137,6 +151,7 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
     if (!u.applied()) return InputResult::of(u.outcome);
     global_.last_correction_ns = now;
     corrected(now);
+    if (known) note_grulps_correction(now);
     return InputResult::ok();
   }
   LocalGroup& l = local_.at(group);  // uncalibrated: only its own frame uses it
@@ -164,12 +179,17 @@ void ScanEstimator::process_epoch(const Epoch& epoch) {
   const StampNs now = now_ns().value_or(epoch.ranges.back().stamp_ns);
   auto local = local_.find(epoch.group);
   if (local == local_.end()) {  // a GRULPS, or an LRULPS calibrated already: the global frame's
+    const bool grulps = map().find(epoch.ranges.front().beacon_id) != nullptr;
     if (!global_.started) {
       start_frame(global_, epoch, true);
-    } else if (params_.geometry == Geometry::kHyperbolic && fuse_epoch(global_, epoch, true)) {
+      return;
+    }
+    if (params_.geometry == Geometry::kHyperbolic && fuse_epoch(global_, epoch, true)) {
       global_.last_correction_ns = now;
       corrected(now);
+      if (grulps) note_grulps_correction(now);
     }
+    if (grulps) check_against_grulps(epoch);
     return;
   }
   LocalGroup& l = local->second;
@@ -198,7 +218,7 @@ void ScanEstimator::process_epoch(const Epoch& epoch) {
   }
 }
 
-std::optional<GroupFix> ScanEstimator::start_frame(Frame& frame, const Epoch& epoch, bool global) {
+std::optional<GroupFix> ScanEstimator::fix_of(const Epoch& epoch, bool global) {
   GroupMeasurements m;
   m.geometry = params_.geometry;
   m.receiver_z_m = receivers_.receiver_height_m;
@@ -216,24 +236,30 @@ std::optional<GroupFix> ScanEstimator::start_frame(Frame& frame, const Epoch& ep
     m.ranges_m.push_back(e.range_m + *e.range_rate_mps * ns_to_s(reference_ns - e.stamp_ns));
     variance_sum += e.variance_m2;
   }
+  const bool first_pose = global && !global_.started;
   const std::size_t needed = beacons_for_a_fix(params_.geometry);
   if (m.beacons_m.size() < needed) {
-    if (global) {
+    if (first_pose) {
       waiting_for_ = {StartupCondition::kTooFewBeacons, static_cast<double>(m.beacons_m.size()),
                       static_cast<double>(needed), {}};
     }
     return std::nullopt;
   }
   m.range_sigma_m = std::sqrt(variance_sum / static_cast<double>(m.ranges_m.size()));
-  GroupFix fix = solve_group_fix(m);
-  frame.last_fix_failure = fix.failure;
+  const GroupFix fix = solve_group_fix(m);
   if (!fix.ok()) {
-    if (global) waiting_for_ = {StartupCondition::kFixFailed, 0.0, 0.0, to_string(fix.failure)};
+    if (first_pose) waiting_for_ = {StartupCondition::kFixFailed, 0.0, 0.0, to_string(fix.failure)};
     return std::nullopt;
   }
-  const std::optional<FrameBelief> belief = frame.start.add_fix(fix);
+  return fix;
+}
+
+std::optional<GroupFix> ScanEstimator::start_frame(Frame& frame, const Epoch& epoch, bool global) {
+  const std::optional<GroupFix> fix = fix_of(epoch, global);
+  if (!fix) return std::nullopt;
+  const std::optional<FrameBelief> belief = frame.start.add_fix(*fix);
   if (!belief) {
-    if (global) {
+    if (global && !global_.started) {
       waiting_for_ = {StartupCondition::kNeedsMotion, frame.start.displacement_m(), params_.start.heading_baseline_m, {}};
     }
     return fix;
@@ -243,10 +269,31 @@ std::optional<GroupFix> ScanEstimator::start_frame(Frame& frame, const Epoch& ep
   pose.head<2>() -= transform_point(Pose2(0.0, 0.0, pose.z()), receivers_.receivers_base_m[0]);
   if (frame.filter.start(pose, belief->covariance) != FilterOutcome::kApplied) return std::nullopt;
   frame.started = true;
+  frame.relocating = false;
   const StampNs now = now_ns().value_or(epoch.ranges.back().stamp_ns);
   frame.last_correction_ns = now;
   if (global) start(now);
   return fix;
+}
+
+void ScanEstimator::check_against_grulps(const Epoch& epoch) {
+  if (global_.relocating) {  // every fix goes to the new start; one the filter agrees with ends it
+    const std::optional<GroupFix> fix = start_frame(global_, epoch, true);
+    if (!fix || !global_.relocating) return;
+  }
+  const std::optional<GroupFix> fix = global_.relocating ? std::nullopt : fix_of(epoch, true);
+  const auto disagrees = [&](const GroupFix& f) {
+    const Eigen::Vector2d d = f.position_m - transform_point(global_.filter.pose(), receivers_.receivers_base_m[0]);
+    const Eigen::Matrix2d s = f.covariance_m2 + global_.filter.covariance().topLeftCorner<2, 2>();
+    const Eigen::LDLT<Eigen::Matrix2d> factor(s);
+    return factor.info() != Eigen::Success || !(d.dot(factor.solve(d)) <= chi_square_quantile_999(2));
+  };
+  if (global_.relocating) return;
+  if (fix && disagrees(*fix)) {
+    global_.relocating = true;
+    global_.start = FrameStart(params_.start);
+    global_.start.add_fix(*fix);
+  }
 }
 
 bool ScanEstimator::fuse_epoch(Frame& frame, const Epoch& epoch, bool global) {
@@ -334,14 +381,91 @@ void ScanEstimator::finish_overlaps(StampNs now_ns) {
       ++it;
       continue;
     }
-    for (const CalibratedBeacon& b : g->beacons) calibrated_[b.id] = b;
-    calibration_.groups.push_back(*g);
+    const std::uint32_t group = it->first;
     it = local_.erase(it);
+    calibrate(group, *g);
+    ++calibrated_since_grulps_;
   }
 }
 
+// A group's calibration in, or in place of the one it had.
+void ScanEstimator::calibrate(std::uint32_t group, const GroupCalibration& g) {
+  for (const CalibratedBeacon& b : g.beacons) calibrated_[b.id] = b;
+  for (GroupCalibration& old : calibration_.groups) {
+    if (old.group == group) {
+      old = g;
+      return;
+    }
+  }
+  calibration_.groups.push_back(g);
+}
+
+void ScanEstimator::record(const RecordedInput& input) {
+  if (!params_.inverse_trajectory || log_full_) return;
+  if (log_.size() >= params_.max_recorded_inputs) {
+    log_full_ = true;  // this leg gets no backwards drive
+    log_.clear();
+    return;
+  }
+  log_.push_back(input);
+}
+
+void ScanEstimator::note_grulps_correction(StampNs now_ns) {
+  // Back from outside every GRULPS, with groups calibrated on the way: the backwards drive will
+  // start here once the robot has been here for inverse_after_s.
+  const bool was_away = !last_grulps_correction_ns_ || now_ns - *last_grulps_correction_ns_ > s_to_ns(params_.overlap_end_s);
+  if (was_away && last_grulps_correction_ns_ && calibrated_since_grulps_ > 0 && !back_in_grulps_since_ns_) {
+    back_in_grulps_since_ns_ = now_ns;
+  }
+  last_grulps_correction_ns_ = now_ns;
+}
+
+void ScanEstimator::maybe_run_inverse_trajectory(StampNs now_ns, bool now_or_never) {
+  if (!back_in_grulps_since_ns_) return;
+  if (!now_or_never && now_ns - *back_in_grulps_since_ns_ < s_to_ns(params_.inverse_after_s)) return;
+  back_in_grulps_since_ns_.reset();
+  calibrated_since_grulps_ = 0;
+  if (!params_.inverse_trajectory || log_full_) {
+    ++inverse_passes_skipped_;
+  } else {
+    ++inverse_passes_;
+    const BeaconCalibration backwards = inverse_trajectory_calibration(config_, map(), log_);
+    for (const GroupCalibration& b : backwards.groups) {
+      const auto forwards = std::find_if(calibration_.groups.begin(), calibration_.groups.end(),
+                                         [&](const GroupCalibration& f) { return f.group == b.group; });
+      const bool better = forwards == calibration_.groups.end() ||
+                          b.beacons.front().covariance_m2.trace() < forwards->beacons.front().covariance_m2.trace();
+      if (better) {
+        local_.erase(b.group);
+        calibrate(b.group, b);
+      }
+    }
+  }
+  // The next leg starts here.
+  log_.clear();
+  log_full_ = false;
+}
+
+void ScanEstimator::finish() {
+  if (!now_ns()) return;
+  close_epochs(*now_ns(), true);
+  for (auto it = local_.begin(); it != local_.end();) {
+    const std::optional<GroupCalibration> g = transform_of(it->first, it->second, *now_ns());
+    if (!g) {
+      ++it;
+      continue;
+    }
+    const std::uint32_t group = it->first;
+    it = local_.erase(it);
+    calibrate(group, *g);
+  }
+  maybe_run_inverse_trajectory(*now_ns(), true);
+}
+
 std::vector<Estimator::StateValue> ScanEstimator::state_values() const {
-  return {{"calibrated_groups", static_cast<double>(calibration_.groups.size()), 0.0}};
+  return {{"calibrated_groups", static_cast<double>(calibration_.groups.size()), 0.0},
+          {"inverse_passes", static_cast<double>(inverse_passes_), 0.0},
+          {"inverse_passes_skipped", static_cast<double>(inverse_passes_skipped_), 0.0}};
 }
 
 BEACONLOC_REGISTER_ESTIMATOR("scan",

@@ -25,7 +25,12 @@
 //    (10 cm on seed 003: the ranges to the beacons that fire later are shorter). A fix is made of
 //    the ranges brought to the epoch's last instant by each beacon's range rate since its
 //    previous range (one group cycle before); a range without a recent predecessor waits.
-//  - the inverse-trajectory pass (Sec. 3.6) is not here yet (issue 16, item 2).
+//  - the inverse trajectory (Sec. 3.6, inverse_trajectory.hpp): the inputs since the robot last
+//    left a GRULPS are kept; once it has been back in a GRULPS's coverage (any, the same one
+//    after a loop too) for inverse_after_s, with groups calibrated on the way, the drive is run
+//    backwards from there on a fresh estimator, and each group takes the calibration, forwards
+//    or backwards, whose beacon covariance is the smaller (the paper takes the backwards one for
+//    "the last LRULPS calibrated"; the covariance says which is last from either end).
 #include <deque>
 #include <map>
 #include <optional>
@@ -36,6 +41,8 @@
 #include "scan/frame_filter.hpp"
 #include "scan/frame_start.hpp"
 #include "scan/group_fix.hpp"
+#include "scan/input_log.hpp"
+#include "scan/inverse_trajectory.hpp"
 #include "scan/similarity_transform.hpp"
 
 namespace beaconloc::scan {
@@ -55,6 +62,14 @@ struct ScanParameters {
   double overlap_end_s = 2.0;       // see the header: > 2 of a group's cycles (0.76 s)
   double max_odometry_gap_s = 0.2;
   double wheel_velocity_variance_floor_m2ps2 = 1e-6;
+  bool inverse_trajectory = true;  // Sec. 3.6
+  // In a GRULPS's coverage this long before the backwards drive starts from there: the drive
+  // needs the GRULPS's fixes at its start (5 s, on seed 003 at the coverage's edge, was too
+  // short on one seed in four: the backwards global frame started as it left the GRULPS).
+  double inverse_after_s = 10.0;
+  // The inputs kept for it (30 min of 100 Hz odometry and the ranges between: 21 MB); a longer
+  // leg between two GRULPSs has no backwards drive (inverse_passes_skipped counts it).
+  std::size_t max_recorded_inputs = 300000;
 
   static ScanParameters from(const EstimatorConfig& config);
 };
@@ -68,6 +83,10 @@ class ScanEstimator final : public EstimatorBase {
   InputResult update(const RangeMeasurement& range) override;
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<ScanEstimator>(*this); }
   std::vector<StateValue> state_values() const override;
+  // The drive is over (the end of a recording, the virtual drive of Sec. 3.6): every open epoch
+  // is taken, every overlap under way ends (its group calibrated, if it can be), and a backwards
+  // drive that was waiting for inverse_after_s runs now.
+  void finish();
 
   // The groups calibrated so far (each once its overlap ended), in the order they were.
   const BeaconCalibration& calibration() const { return calibration_; }
@@ -103,8 +122,11 @@ class ScanEstimator final : public EstimatorBase {
     FrameFilter filter;
     FrameStart start;
     bool started = false;
+    // The global frame only: a GRULPS's fix contradicts the filter (it drifted between groups
+    // whose calibration was off, beyond what its covariance says): the frame is found again
+    // from two GRULPS fixes, as at the start, while the filter goes on, degraded.
+    bool relocating = false;
     std::optional<StampNs> last_correction_ns;
-    std::optional<GroupFixFailure> last_fix_failure;
   };
   // An LRULPS while it is calibrated: its frame and the overlap's pairs.
   struct LocalGroup {
@@ -118,8 +140,14 @@ class ScanEstimator final : public EstimatorBase {
 
   void close_epochs(StampNs now_ns, bool all);
   void process_epoch(const Epoch& epoch);
-  // The epoch's fix (a fix that started the frame included), nullopt when it gave none.
+  // The epoch's Gauss-Newton fix in the frame (Sec. 3.2-3.3), nullopt when it gives none (too
+  // few ranges, the solver's refusal: what the global frame waits for, before its first pose).
+  std::optional<GroupFix> fix_of(const Epoch& epoch, bool global);
+  // The epoch's fix given to the frame's start (a fix that started the frame included).
   std::optional<GroupFix> start_frame(Frame& frame, const Epoch& epoch, bool global);
+  // A GRULPS epoch while the global frame tracks: its fix checked against the filter.
+  void check_against_grulps(const Epoch& epoch);
+  bool suspect() const override { return global_.relocating; }
   bool fuse_epoch(Frame& frame, const Epoch& epoch, bool global);
   // global_pose: the global frame's pose at the instant the local point is of.
   void add_pair(LocalGroup& local, const Eigen::Vector2d& local_receiver_m, const Pose2& global_pose);
@@ -129,7 +157,13 @@ class ScanEstimator final : public EstimatorBase {
   // uncalibrated one.
   std::optional<FrameBeacon> global_beacon(std::uint32_t id) const;
   bool recently(const std::optional<StampNs>& stamp_ns, StampNs now_ns) const;
+  // A correction of the global frame by a group of the map's own (a GRULPS).
+  void note_grulps_correction(StampNs now_ns);
+  void maybe_run_inverse_trajectory(StampNs now_ns, bool now_or_never);
+  void calibrate(std::uint32_t group, const GroupCalibration& g);
+  void record(const RecordedInput& input);
 
+  EstimatorConfig config_;  // for the backwards drive's estimator
   ReceiverArray receivers_;
   ScanParameters params_;
   StartupWait waiting_for_;
@@ -140,6 +174,14 @@ class ScanEstimator final : public EstimatorBase {
   BeaconCalibration calibration_;
   std::map<std::uint32_t, Epoch> open_epochs_;  // by group
   std::map<std::uint32_t, std::pair<StampNs, double>> last_range_;  // by beacon: its previous range's stamp, range
+  // Sec. 3.6: the inputs since the robot last left a GRULPS, and when it came back to one.
+  InputLog<RecordedInput> log_;
+  bool log_full_ = false;
+  std::optional<StampNs> last_grulps_correction_ns_;
+  std::optional<StampNs> back_in_grulps_since_ns_;
+  std::size_t calibrated_since_grulps_ = 0;
+  std::size_t inverse_passes_ = 0;
+  std::size_t inverse_passes_skipped_ = 0;
 };
 
 }  // namespace beaconloc::scan

@@ -67,6 +67,7 @@ ScanRun run(const sim::Scenario& s, std::uint64_t seed, const std::map<std::stri
       next_print_s += 5.0;
     }
   }
+  scan.finish();  // the recording ends
   out.position_rms_m = out.poses ? std::sqrt(sum2 / static_cast<double>(out.poses)) : 0.0;
   out.calibration = scan.calibration();
   const BeaconMap truth(s.beacons);

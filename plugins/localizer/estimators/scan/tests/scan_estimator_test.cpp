@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "offline_run.hpp"
+#include "beaconloc/core/models/diff_drive_motion.hpp"
+#include "scan/inverse_trajectory.hpp"
 #include "scan/scan_estimator.hpp"
 #include "sim/scenario_yaml.hpp"
 
@@ -132,8 +135,107 @@ TEST(ScanEstimator, CalibratesEveryGroupOnTheDriveAndACloneGoesOnAlike) {
   EXPECT_EQ(copy->estimate()->pose_map_base, scan.estimate()->pose_map_base);
   EXPECT_EQ(dynamic_cast<ScanEstimator&>(*copy).calibration(), scan.calibration());
   const std::vector<Estimator::StateValue> values = scan.state_values();
-  ASSERT_EQ(values.size(), 1u);
+  ASSERT_EQ(values.size(), 3u);
+  EXPECT_EQ(values[0].name, "calibrated_groups");
   EXPECT_EQ(values[0].value, static_cast<double>(s.local_group_frames_map.size()));
+  EXPECT_EQ(values[1].name, "inverse_passes");
+  EXPECT_EQ(values[1].value, 1.0);  // back in GRULPS 2 for 10 s
+}
+
+// Sec. 3.6: the backwards drive starts next to GRULPS 2, so the last groups of the drive are
+// calibrated better by it; without it they carry the whole chain's error.
+TEST(ScanEstimator, TheInverseTrajectoryCalibratesTheLastGroupsBetter) {
+  const sim::Scenario s = seed003();
+  const BeaconMap truth(s.beacons);
+  const auto last_group_error = [&](double inverse) {
+    ScanEstimator scan(config_of(s, {{"inverse_trajectory", inverse}}));
+    scan.set_beacon_map(BeaconMap(s.beacon_list()));
+    for (const EstimatorInput& in : inputs(s, s.duration_s)) scan.push(in);
+    scan.finish();
+    for (const GroupCalibration& g : scan.calibration().groups) {
+      if (g.group != 9) continue;
+      double sum = 0.0;
+      for (const CalibratedBeacon& b : g.beacons) {
+        sum += (b.position_map_m.head<2>() - truth.find(b.id)->position_map_m.head<2>()).norm();
+      }
+      return sum / static_cast<double>(g.beacons.size());
+    }
+    ADD_FAILURE() << "group 9 not calibrated";
+    return 0.0;
+  };
+  const double with = last_group_error(1.0), without = last_group_error(0.0);
+  std::printf("LRULPS #7 (group 9), seed 1: %.3f m with the inverse trajectory, %.3f m without\n", with, without);
+  EXPECT_LT(with, 0.15);
+  EXPECT_LT(with, 0.5 * without);
+}
+
+TEST(InputLog, KeepsEveryItemNewestFirstAndCopiesShareTheSealedPart) {
+  InputLog<int> log;
+  for (int i = 0; i < 1000; ++i) log.push_back(i);
+  InputLog<int> copy = log;
+  copy.push_back(1000);
+  std::vector<int> seen;
+  log.newest_first([&](int v) { seen.push_back(v); });
+  ASSERT_EQ(seen.size(), 1000u);
+  for (int i = 0; i < 1000; ++i) EXPECT_EQ(seen[static_cast<std::size_t>(i)], 999 - i);
+  int first = -1;
+  copy.newest_first([&](int v) {
+    if (first < 0) first = v;
+  });
+  EXPECT_EQ(first, 1000);
+  EXPECT_EQ(copy.size(), 1001u);
+  copy.clear();
+  EXPECT_TRUE(copy.empty());
+  EXPECT_EQ(log.size(), 1000u);  // the original keeps its items
+}
+
+// The backwards drive: stamps mirrored from the newest, ranges as they were, each odometry
+// sample carrying the next one's wheel speeds negated (the interval it now covers), and the
+// dead-reckoned path driven backwards ends where the forward one began.
+TEST(InverseTrajectory, TheInputsAreTheDriveBackwards) {
+  InputLog<RecordedInput> log;
+  Pose2 forward = Pose2::Zero();
+  for (int k = 0; k <= 300; ++k) {
+    OdometrySample o;
+    o.stamp_ns = StampNs{1'000'000'000} + StampNs{k} * 10'000'000;
+    o.wheel_base_m = 0.33;
+    o.wheel_velocity_right_mps = 0.4 + 0.001 * k;
+    o.wheel_velocity_left_mps = 0.35;
+    if (k > 0) forward = predict_diff_drive(forward, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps, 0.33, 0.01).pose;
+    log.push_back(o);
+    if (k % 7 == 3) {
+      RangeMeasurement r;
+      r.stamp_ns = o.stamp_ns + 4'000'000;
+      r.beacon_id = static_cast<std::uint32_t>(k);
+      r.range_m = 2.0 + 0.01 * k;
+      r.variance_m2 = 1e-4;
+      log.push_back(r);
+    }
+  }
+  const std::vector<RecordedInput> back = reversed_inputs(log);
+  ASSERT_EQ(back.size(), log.size());
+  StampNs previous = -1;
+  Pose2 backwards = forward;  // from where the drive ended
+  std::optional<StampNs> last_odometry;
+  for (const RecordedInput& in : back) {
+    const StampNs t = std::visit([](const auto& x) { return x.stamp_ns; }, in);
+    EXPECT_GE(t, previous);
+    previous = t;
+    if (const auto* o = std::get_if<OdometrySample>(&in)) {
+      if (last_odometry) {
+        backwards = predict_diff_drive(backwards, o->wheel_velocity_right_mps, o->wheel_velocity_left_mps, 0.33,
+                                       ns_to_s(t - *last_odometry))
+                        .pose;
+      }
+      last_odometry = t;
+    } else {
+      const auto& r = std::get<RangeMeasurement>(in);
+      EXPECT_DOUBLE_EQ(r.range_m, 2.0 + 0.01 * r.beacon_id);
+      EXPECT_EQ(r.stamp_ns, StampNs{1'000'000'000} + 300 * StampNs{10'000'000} - (1'000'000'000 + static_cast<StampNs>(r.beacon_id) * 10'000'000 + 4'000'000));
+    }
+  }
+  EXPECT_LT(backwards.head<2>().norm(), 1e-9) << backwards.transpose();
+  EXPECT_NEAR(backwards.z(), 0.0, 1e-9);
 }
 
 }  // namespace
