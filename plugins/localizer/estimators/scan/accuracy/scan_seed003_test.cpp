@@ -107,7 +107,8 @@ double mean_of(const std::vector<double>& v) {
 
 // Sec. 4.1-4.2 and Fig. 13: the beacons' calibration error over the runs, EKF, UKF and
 // H-infinity side by side on the same runs (the same seeds), spherical and hyperbolic, with the
-// analytic transform (d_min = 2.5 m) and the inverse trajectory. Every LRULPS is calibrated on
+// analytic transform (d_min = 2.5 m) and the numerical one (Sec. 4.2: 20 points), and the
+// inverse trajectory. Every LRULPS is calibrated on
 // every run, in the order the robot meets them; the first (beside GRULPS 1) to under 0.1 m on
 // average (100 runs: 0.067 m spherical, 0.080 m hyperbolic; one run in six above 0.1 m); the
 // worst is one of the two in the middle of the chain (LRULPS #4 or #5: groups 6 and 7), farthest
@@ -118,12 +119,13 @@ double mean_of(const std::vector<double>& v) {
 TEST(ScanOnSeed003, EveryGroupIsCalibratedAndTheWorstIsInTheMiddle) {
   const sim::Scenario s = seed003();
   const int n = runs();
+  for (const double numerical : {0.0, 1.0}) {
   for (const double hyperbolic : {0.0, 1.0}) {
     for (const double filter : {0.0, 1.0, 2.0}) {
       std::map<std::uint32_t, std::vector<double>> by_group;  // each run's mean over the group's beacons
       std::vector<double> all;
       for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(n); ++seed) {
-        const ScanRun r = run(s, seed, {{"filter", filter}, {"hyperbolic", hyperbolic}});
+        const ScanRun r = run(s, seed, {{"filter", filter}, {"hyperbolic", hyperbolic}, {"numerical_transform", numerical}});
         ASSERT_EQ(r.calibration.groups.size(), s.local_group_frames_map.size())
             << "seed " << seed << " filter " << filter << " hyperbolic " << hyperbolic;
         std::vector<std::uint32_t> order;
@@ -134,8 +136,8 @@ TEST(ScanOnSeed003, EveryGroupIsCalibratedAndTheWorstIsInTheMiddle) {
       }
       std::uint32_t worst = 0;
       double worst_mean = -1.0;
-      std::printf("%s %s, %d runs: mean beacon error %.3f m; by group (mean):",
-                  hyperbolic > 0 ? "hyperbolic" : "spherical",
+      std::printf("%s %s %s, %d runs: mean beacon error %.3f m; by group (mean):",
+                  numerical > 0 ? "numerical" : "analytic", hyperbolic > 0 ? "hyperbolic" : "spherical",
                   to_string(static_cast<FilterKind>(static_cast<int>(filter))), n, mean_of(all));
       for (const auto& [g, errors] : by_group) {
         std::printf(" %u: %.3f", g, mean_of(errors));
@@ -147,8 +149,10 @@ TEST(ScanOnSeed003, EveryGroupIsCalibratedAndTheWorstIsInTheMiddle) {
       std::printf("; worst %u\n", worst);
       EXPECT_TRUE(worst == 6 || worst == 7) << worst;
       EXPECT_LT(mean_of(by_group[3]), 0.10);
-      EXPECT_LT(mean_of(all), hyperbolic > 0 ? 0.40 : 0.35);
+      // The paper's 0.4 m hyperbolic (analytic); the others regression guards (see above).
+      EXPECT_LT(mean_of(all), hyperbolic > 0 ? (numerical > 0 ? 0.50 : 0.40) : 0.35);
     }
+  }
   }
 }
 
