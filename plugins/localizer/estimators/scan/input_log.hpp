@@ -14,9 +14,23 @@ namespace beaconloc::scan {
 template <class T>
 class InputLog {
  public:
-  // 128 items: a copy copies at most 128 of them; walking 30 min of inputs (300 000) takes
-  // 2 300 chunks, which is also the depth of the chain's destruction.
+  // 128 items: a copy copies at most 128 of them.
   static constexpr std::size_t kChunkItems = 128;
+
+  InputLog() = default;
+  InputLog(const InputLog&) = default;
+  InputLog& operator=(const InputLog& other) {
+    if (this != &other) {
+      clear();
+      sealed_ = other.sealed_;
+      open_ = other.open_;
+      size_ = other.size_;
+    }
+    return *this;
+  }
+  InputLog(InputLog&&) = default;
+  InputLog& operator=(InputLog&&) = delete;
+  ~InputLog() { clear(); }
 
   void push_back(T item) {
     open_.push_back(std::move(item));
@@ -29,7 +43,12 @@ class InputLog {
   }
   std::size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
+  // The chunks no copy shares are freed one by one, not by a recursion as deep as the chain.
   void clear() {
+    while (sealed_ && sealed_.use_count() == 1) {
+      std::shared_ptr<const Chunk> older = sealed_->older;
+      sealed_ = std::move(older);  // frees the newest chunk; its link to the older one is not the last
+    }
     sealed_.reset();
     open_.clear();
     size_ = 0;

@@ -17,6 +17,12 @@ namespace {
 // A beacon's range rate is taken from its previous range when that is at most this old (two of
 // seed003_scan.yaml's 0.76 s cycles, with one missed).
 constexpr StampNs kRangeRateWindowNs = 2 * kNsPerSecond;
+// More ranges in one group's epoch than any ULPS has beacons (the paper's have 4-5): a flood,
+// refused before a Gauss-Newton fix over them costs O(n^3) per iteration.
+constexpr std::size_t kMaxEpochRanges = 64;
+// A frame relocates after this many GRULPS fixes in a row contradict it (one may be an echo's),
+// and stops relocating after as many agree.
+constexpr int kFixesToRelocate = 2;
 
 // Sec. 2: three beacons at least for a spherical fix, four for a hyperbolic one.
 std::size_t beacons_for_a_fix(Geometry g) { return g == Geometry::kSpherical ? 3 : 4; }
@@ -58,10 +64,30 @@ ScanEstimator::ScanEstimator(const EstimatorConfig& config, const ScanParameters
   waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(beacons_for_a_fix(params_.geometry)), {}};
 }
 
+// Everything measured against the beacons goes with the map they were measured against (the
+// localizer makes a new estimator for a new map; this holds for any caller).
 void ScanEstimator::set_beacon_map(const BeaconMap& map) {
   EstimatorBase::set_beacon_map(map);
+  if (has_pose()) forget_pose();
+  global_ = Frame(params_);
   local_.clear();
   for (const LocalBeacon& b : map.local_beacons()) local_.try_emplace(b.group, params_);
+  calibrated_.clear();
+  calibration_ = {};
+  open_epochs_.clear();
+  last_range_.clear();
+  log_.clear();
+  log_full_ = false;
+  last_grulps_correction_ns_.reset();
+  back_in_grulps_since_ns_.reset();
+  calibrated_since_grulps_ = 0;
+  waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(beacons_for_a_fix(params_.geometry)), {}};
+}
+
+bool ScanEstimator::pairs_possible(StampNs now_ns) const {
+  // Corrected within overlap_end_s: a window of one group cycle (1 s) left so few pairs on seed
+  // 003 that the calibrations were worse (0.214-0.351 m against 0.221-0.250 m on seeds 1-4).
+  return global_.started && !global_.relocating && recently(global_.last_correction_ns, now_ns);
 }
 
 bool ScanEstimator::recently(const std::optional<StampNs>& stamp_ns, StampNs now_ns) const {
@@ -89,10 +115,12 @@ InputResult ScanEstimator::predict(const OdometrySample& o) {
     }
     return f.started ? f.filter.predict(o, step.dt_s, floor) : f.start.predict(o, step.dt_s, floor);
   };
-  if (const PredictResult r = advance_frame(global_); !r.applied()) return InputResult::of(r.outcome);
+  const PredictResult global_step = advance_frame(global_);
+  // A group's frame that cannot be moved starts again (its next fixes); the map pose goes on.
   for (auto& [group, local] : local_) {
-    if (const PredictResult r = advance_frame(local.frame); !r.applied()) return InputResult::of(r.outcome);
+    if (!advance_frame(local.frame).applied()) local.frame = Frame(params_);
   }
+  if (!global_step.applied()) return InputResult::of(global_step.outcome);
   record(o);
   const StampNs now = *now_ns();
   close_epochs(now, false);
@@ -110,10 +138,20 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   if (!known && !local) return InputResult::rejected(Rejection::kUnknownBeacon);
   if (r.receiver_id >= receivers_.size()) return InputResult::rejected(Rejection::kUnknownReceiver);
   if (now_ns() && r.stamp_ns < *now_ns() - kMeasurementHorizonNs) return InputResult::rejected(Rejection::kStaleRange);
+  // Pushed in stamp order, a range is at most an odometry period ahead of the newest odometry; one
+  // further ahead would poison its beacon's range rate for every later fix.
+  if (now_ns() && r.stamp_ns > *now_ns() + s_to_ns(params_.epoch_window_s)) {
+    return InputResult::rejected(Rejection::kAheadOfOdometry);
+  }
+  if (auto last = last_range_.find(r.beacon_id); last != last_range_.end() && last->second.first == r.stamp_ns) {
+    return InputResult::rejected(Rejection::kDuplicateRange);
+  }
 
   // Every good range joins its group's epoch (the fixes and the hyperbolic updates are made of them).
   const std::uint32_t group = known ? known->group : local->group;
-  const StampNs now = now_ns().value_or(r.stamp_ns);
+  // A frame's correction is stamped with the range (up to an odometry period after the newest
+  // odometry), so that an epoch's first range counts as inside it.
+  const StampNs now = std::max(now_ns().value_or(r.stamp_ns), r.stamp_ns);
   auto open = open_epochs_.find(group);
   if (open != open_epochs_.end()) {
     const Epoch& e = open->second;
@@ -127,12 +165,14 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   }
   Epoch& epoch = open_epochs_[group];
   epoch.group = group;
-  if (epoch.ranges.size() >= kMaxBeacons) return InputResult::rejected(Rejection::kImplausibleRange);
+  if (epoch.ranges.size() >= kMaxEpochRanges) return InputResult::rejected(Rejection::kTooManyRangesInEpoch);
   record(r);
   std::optional<double> rate_mps;
   if (auto last = last_range_.find(r.beacon_id); last != last_range_.end()) {
     const StampNs dt_ns = r.stamp_ns - last->second.first;
+    // A range cannot change faster than the robot moves: a faster "rate" is an echo's.
     if (dt_ns > 0 && dt_ns <= kRangeRateWindowNs) rate_mps = (r.range_m - last->second.second) / ns_to_s(dt_ns);
+    if (rate_mps && !(std::abs(*rate_mps) <= kMaxWheelSpeedMps)) rate_mps.reset();
   }
   last_range_[r.beacon_id] = {r.stamp_ns, r.range_m};
   epoch.ranges.push_back({r.beacon_id, r.range_m, r.variance_m2, odometry_pose_, r.stamp_ns, rate_mps});
@@ -149,12 +189,13 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
                                          r.range_m, r.variance_m2 + extra);
     }();
     if (!u.applied()) return InputResult::of(u.outcome);
-    global_.last_correction_ns = now;
-    corrected(now);
+    global_corrected(now);
     if (known) note_grulps_correction(now);
     return InputResult::ok();
   }
-  LocalGroup& l = local_.at(group);  // uncalibrated: only its own frame uses it
+  const auto uncalibrated = local_.find(group);  // uncalibrated: only its own frame uses it
+  if (uncalibrated == local_.end()) return InputResult::rejected(Rejection::kUncalibratedBeacon);
+  LocalGroup& l = uncalibrated->second;
   if (!l.frame.started) return InputResult::ok();
   const UpdateResult u = l.frame.filter.update_range(receivers_.receivers_base_m[0], receivers_.receiver_height_m,
                                                      local->position_group_m, r.range_m, r.variance_m2);
@@ -185,11 +226,10 @@ void ScanEstimator::process_epoch(const Epoch& epoch) {
       return;
     }
     if (params_.geometry == Geometry::kHyperbolic && fuse_epoch(global_, epoch, true)) {
-      global_.last_correction_ns = now;
-      corrected(now);
+      global_corrected(now);
       if (grulps) note_grulps_correction(now);
     }
-    if (grulps) check_against_grulps(epoch);
+    check_fix(epoch, grulps);
     return;
   }
   LocalGroup& l = local->second;
@@ -203,7 +243,7 @@ void ScanEstimator::process_epoch(const Epoch& epoch) {
     // through the odometry), or the lag of every fix (and of no filter point) shrinks the local
     // track against the global (a scale of 0.99 on seed 003).
     const std::optional<GroupFix> fix = start_frame(l.frame, epoch, false);
-    if (fix && global_.started && recently(global_.last_correction_ns, now)) {
+    if (fix && pairs_possible(now)) {
       const Pose2& then = epoch.ranges.back().odometry_pose;
       add_pair(l, fix->position_m, compose(global_.filter.pose(), between(odometry_pose_, then)));
     }
@@ -213,7 +253,7 @@ void ScanEstimator::process_epoch(const Epoch& epoch) {
   // The overlap (Sec. 3.5): this group's frame corrected within this epoch and the global frame
   // by a group it knows, lately; both filters are at the same instant (the same odometry).
   const bool local_now = l.frame.last_correction_ns && *l.frame.last_correction_ns >= epoch.ranges.front().stamp_ns;
-  if (local_now && global_.started && recently(global_.last_correction_ns, now)) {
+  if (local_now && pairs_possible(now)) {
     add_pair(l, transform_point(l.frame.filter.pose(), receivers_.receivers_base_m[0]), global_.filter.pose());
   }
 }
@@ -231,7 +271,9 @@ std::optional<GroupFix> ScanEstimator::fix_of(const Epoch& epoch, bool global) {
       if (!b) continue;
       m.beacons_m.push_back(b->position_m);
     } else {
-      m.beacons_m.push_back(map().find_local(e.beacon_id)->position_group_m);
+      const LocalBeacon* b = map().find_local(e.beacon_id);
+      if (!b) continue;
+      m.beacons_m.push_back(b->position_group_m);
     }
     m.ranges_m.push_back(e.range_m + *e.range_rate_mps * ns_to_s(reference_ns - e.stamp_ns));
     variance_sum += e.variance_m2;
@@ -276,24 +318,40 @@ std::optional<GroupFix> ScanEstimator::start_frame(Frame& frame, const Epoch& ep
   return fix;
 }
 
-void ScanEstimator::check_against_grulps(const Epoch& epoch) {
-  if (global_.relocating) {  // every fix goes to the new start; one the filter agrees with ends it
-    const std::optional<GroupFix> fix = start_frame(global_, epoch, true);
-    if (!fix || !global_.relocating) return;
+// A correction after a coast longer than the staleness policy's degraded_after: the filter may
+// have drifted beyond its covariance, and a range that happens to fit says little. The pose stays
+// suspect until a fix of a known group agrees with it.
+void ScanEstimator::global_corrected(StampNs now_ns) {
+  if (global_.last_correction_ns && now_ns - *global_.last_correction_ns > StalenessPolicy{}.degraded_after_ns) {
+    global_.unconfirmed = true;
   }
-  const std::optional<GroupFix> fix = global_.relocating ? std::nullopt : fix_of(epoch, true);
-  const auto disagrees = [&](const GroupFix& f) {
-    const Eigen::Vector2d d = f.position_m - transform_point(global_.filter.pose(), receivers_.receivers_base_m[0]);
-    const Eigen::Matrix2d s = f.covariance_m2 + global_.filter.covariance().topLeftCorner<2, 2>();
-    const Eigen::LDLT<Eigen::Matrix2d> factor(s);
-    return factor.info() != Eigen::Success || !(d.dot(factor.solve(d)) <= chi_square_quantile_999(2));
-  };
-  if (global_.relocating) return;
-  if (fix && disagrees(*fix)) {
+  global_.last_correction_ns = now_ns;
+  corrected(now_ns);
+}
+
+void ScanEstimator::check_fix(const Epoch& epoch, bool grulps) {
+  const std::optional<GroupFix> fix = fix_of(epoch, true);
+  if (!fix) return;
+  // The filter where the fix is: at the epoch's last range, through the odometry since.
+  const Pose2 then = compose(global_.filter.pose(), between(odometry_pose_, epoch.ranges.back().odometry_pose));
+  const Eigen::Vector2d d = fix->position_m - transform_point(then, receivers_.receivers_base_m[0]);
+  const Eigen::LDLT<Eigen::Matrix2d> s(fix->covariance_m2 + global_.filter.covariance().topLeftCorner<2, 2>());
+  const bool disagrees = s.info() != Eigen::Success || !(d.dot(s.solve(d)) <= chi_square_quantile_999(2));
+  if (!disagrees) global_.unconfirmed = false;
+  // Only a GRULPS (the map's own beacons) is trusted over the filter: a calibrated group that
+  // disagrees leaves the pose unconfirmed, no more.
+  if (!grulps) return;
+  global_.fixes_in_a_row = disagrees == (global_.fixes_in_a_row >= 0) ? global_.fixes_in_a_row + (disagrees ? 1 : -1)
+                                                                       : (disagrees ? 1 : -1);
+  if (!global_.relocating && global_.fixes_in_a_row >= kFixesToRelocate) {
     global_.relocating = true;
     global_.start = FrameStart(params_.start);
-    global_.start.add_fix(*fix);
+  } else if (global_.relocating && global_.fixes_in_a_row <= -kFixesToRelocate) {
+    global_.relocating = false;  // the filter agrees again: the disagreement was the fixes'
+    return;
   }
+  // While relocating, every fix goes to the new start; its belief replaces the filter's.
+  if (global_.relocating) start_frame(global_, epoch, true);
 }
 
 bool ScanEstimator::fuse_epoch(Frame& frame, const Epoch& epoch, bool global) {
@@ -309,7 +367,9 @@ bool ScanEstimator::fuse_epoch(Frame& frame, const Epoch& epoch, bool global) {
       const Eigen::Vector2d line = position.head<2>() - frame.filter.pose().head<2>();
       extra = line.dot(b->covariance_m2 * line) / (e.range_m * e.range_m);
     } else {
-      position = map().find_local(e.beacon_id)->position_group_m;
+      const LocalBeacon* b = map().find_local(e.beacon_id);
+      if (!b) continue;
+      position = b->position_group_m;
     }
     ranges.push_back({position, e.range_m, e.odometry_pose});
     variance = std::max(variance, e.variance_m2 + extra);  // eq. 19 takes one sigma for all
@@ -418,6 +478,14 @@ void ScanEstimator::note_grulps_correction(StampNs now_ns) {
     back_in_grulps_since_ns_ = now_ns;
   }
   last_grulps_correction_ns_ = now_ns;
+  // Nothing calibrated or under way since the robot was last here: the leg starts now, and what
+  // was kept before it (time spent inside a GRULPS) is dropped.
+  const bool overlap_under_way =
+      std::any_of(local_.begin(), local_.end(), [](const auto& l) { return l.second.pairs > 0; });
+  if (calibrated_since_grulps_ == 0 && !overlap_under_way) {
+    log_.clear();
+    log_full_ = false;
+  }
 }
 
 void ScanEstimator::maybe_run_inverse_trajectory(StampNs now_ns, bool now_or_never) {
@@ -429,8 +497,9 @@ void ScanEstimator::maybe_run_inverse_trajectory(StampNs now_ns, bool now_or_nev
     ++inverse_passes_skipped_;
   } else {
     ++inverse_passes_;
-    const BeaconCalibration backwards = inverse_trajectory_calibration(config_, map(), log_);
-    for (const GroupCalibration& b : backwards.groups) {
+    BeaconCalibration backwards = inverse_trajectory_calibration(config_, map(), log_);
+    for (GroupCalibration& b : backwards.groups) {
+      b.stamp_ns = now_ns;  // found now (the backwards drive's own clock runs from its start)
       const auto forwards = std::find_if(calibration_.groups.begin(), calibration_.groups.end(),
                                          [&](const GroupCalibration& f) { return f.group == b.group; });
       const bool better = forwards == calibration_.groups.end() ||

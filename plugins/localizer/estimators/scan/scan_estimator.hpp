@@ -67,9 +67,11 @@ struct ScanParameters {
   // needs the GRULPS's fixes at its start (5 s, on seed 003 at the coverage's edge, was too
   // short on one seed in four: the backwards global frame started as it left the GRULPS).
   double inverse_after_s = 10.0;
-  // The inputs kept for it (30 min of 100 Hz odometry and the ranges between: 21 MB); a longer
-  // leg between two GRULPSs has no backwards drive (inverse_passes_skipped counts it).
-  std::size_t max_recorded_inputs = 300000;
+  // The inputs kept for it (13 min of 100 Hz odometry and the ranges between: 8.6 MB); a longer
+  // leg between two GRULPSs has no backwards drive (inverse_passes_skipped counts it). The drive
+  // runs inside the odometry step that starts it: 4-40 ms for seed 003's 16 000 inputs (EKF to
+  // UKF), so up to 0.3 s at the cap (BENCHMARKS.md).
+  std::size_t max_recorded_inputs = 120000;
 
   static ScanParameters from(const EstimatorConfig& config);
 };
@@ -122,10 +124,13 @@ class ScanEstimator final : public EstimatorBase {
     FrameFilter filter;
     FrameStart start;
     bool started = false;
-    // The global frame only: a GRULPS's fix contradicts the filter (it drifted between groups
-    // whose calibration was off, beyond what its covariance says): the frame is found again
-    // from two GRULPS fixes, as at the start, while the filter goes on, degraded.
+    // The global frame only: GRULPS fixes contradict the filter (it drifted between groups whose
+    // calibration was off, beyond what its covariance says): the frame is found again from two
+    // GRULPS fixes, as at the start, while the filter goes on, degraded; fixes that agree with
+    // the filter again end it.
     bool relocating = false;
+    int fixes_in_a_row = 0;  // GRULPS fixes: > 0 that many disagreeing in a row, < 0 agreeing
+    bool unconfirmed = false;  // corrected after a coast, and no fix has agreed since
     std::optional<StampNs> last_correction_ns;
   };
   // An LRULPS while it is calibrated: its frame and the overlap's pairs.
@@ -145,9 +150,13 @@ class ScanEstimator final : public EstimatorBase {
   std::optional<GroupFix> fix_of(const Epoch& epoch, bool global);
   // The epoch's fix given to the frame's start (a fix that started the frame included).
   std::optional<GroupFix> start_frame(Frame& frame, const Epoch& epoch, bool global);
-  // A GRULPS epoch while the global frame tracks: its fix checked against the filter.
-  void check_against_grulps(const Epoch& epoch);
-  bool suspect() const override { return global_.relocating; }
+  // An epoch of a known group while the global frame tracks: its fix checked against the filter
+  // (agreeing, it confirms the pose; a GRULPS's disagreeing ones relocate the frame).
+  void check_fix(const Epoch& epoch, bool grulps);
+  void global_corrected(StampNs now_ns);
+  bool suspect() const override {
+    return global_.relocating || global_.unconfirmed || global_.fixes_in_a_row > 0;
+  }
   bool fuse_epoch(Frame& frame, const Epoch& epoch, bool global);
   // global_pose: the global frame's pose at the instant the local point is of.
   void add_pair(LocalGroup& local, const Eigen::Vector2d& local_receiver_m, const Pose2& global_pose);
@@ -157,6 +166,8 @@ class ScanEstimator final : public EstimatorBase {
   // uncalibrated one.
   std::optional<FrameBeacon> global_beacon(std::uint32_t id) const;
   bool recently(const std::optional<StampNs>& stamp_ns, StampNs now_ns) const;
+  // The global frame may give the twin of a local point: tracking, not relocating, corrected lately.
+  bool pairs_possible(StampNs now_ns) const;
   // A correction of the global frame by a group of the map's own (a GRULPS).
   void note_grulps_correction(StampNs now_ns);
   void maybe_run_inverse_trajectory(StampNs now_ns, bool now_or_never);

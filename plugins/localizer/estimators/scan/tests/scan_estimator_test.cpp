@@ -11,6 +11,7 @@
 #include "scan/inverse_trajectory.hpp"
 #include "scan/scan_estimator.hpp"
 #include "sim/scenario_yaml.hpp"
+#include "sim/sim_source.hpp"
 
 namespace beaconloc::scan {
 namespace {
@@ -167,6 +168,112 @@ TEST(ScanEstimator, TheInverseTrajectoryCalibratesTheLastGroupsBetter) {
   std::printf("LRULPS #7 (group 9), seed 1: %.3f m with the inverse trajectory, %.3f m without\n", with, without);
   EXPECT_LT(with, 0.15);
   EXPECT_LT(with, 0.5 * without);
+}
+
+// A global frame the GRULPS contradicts (here: 3 s without ranges while the odometry says the
+// robot went twice as fast as it did, 1.2 m off) is found again from two GRULPS fixes, degraded
+// meanwhile, never ok while wrong.
+TEST(ScanEstimator, AFrameTheGrulpsContradictsIsFoundAgainAndDegradedMeanwhile) {
+  const sim::Scenario s = seed003();
+  ScanEstimator scan(config_of(s));
+  scan.set_beacon_map(BeaconMap(s.beacon_list()));
+  sim::SimSource source(s, 1);
+  std::vector<SourceEvent> events;
+  source.advance(s_to_ns(14.0), events);
+  TofDecoderConfig dc;
+  dc.max_range_m = s.max_range_m;
+  dc.range_sigma_m = s.range_sigma_m;
+  TofDecoder decoder(dc);
+  decoder.set_beacon_map(BeaconMap(s.beacon_list()));
+  bool degraded = false;
+  double worst_ok_error_m = 0.0;
+  for (const SourceEvent& e : events) {
+    const double t = ns_to_s(e.stamp_ns);
+    std::optional<EstimatorInput> in = estimator_input("robot", e, decoder, BeaconInput::kRanges);
+    if (!in) continue;
+    const bool outage = t > 5.0 && t < 8.0;
+    if (outage && std::holds_alternative<RangeMeasurement>(*in)) continue;
+    if (auto* o = std::get_if<OdometrySample>(&*in); o && outage) {
+      o->wheel_velocity_right_mps *= 2.0;
+      o->wheel_velocity_left_mps *= 2.0;
+    }
+    scan.push(*in);
+    if (e.kind != SourceEvent::Kind::kOdometry || !e.has_truth || !scan.estimate() || t < 8.0) continue;
+    const double error_m = (scan.estimate()->pose_map_base.head<2>() - e.truth_map_base.head<2>()).norm();
+    if (scan.status() == PoseStatus::kDegraded) degraded = true;
+    if (scan.status() == PoseStatus::kOk && error_m > 0.3) worst_ok_error_m = std::max(worst_ok_error_m, error_m);
+  }
+  EXPECT_TRUE(degraded);
+  ASSERT_TRUE(scan.estimate());
+  EXPECT_EQ(scan.status(), PoseStatus::kOk);
+  const Pose2 truth = events.back().truth_map_base;
+  EXPECT_LT((scan.estimate()->pose_map_base.head<2>() - truth.head<2>()).norm(), 0.1);
+  // The filter itself takes the GRULPS ranges again once its covariance has grown enough: an ok
+  // pose more than 0.3 m off is a pose the estimator trusted while it was wrong.
+  EXPECT_EQ(worst_ok_error_m, 0.0);
+}
+
+// A map given again mid-run (a new site) starts everything again: nothing measured against the
+// old beacons survives, and an epoch open at the change does not crash it.
+TEST(ScanEstimator, ANewMapStartsEverythingAgain) {
+  const sim::Scenario s = seed003();
+  ScanEstimator scan(config_of(s));
+  scan.set_beacon_map(BeaconMap(s.beacon_list()));
+  const std::vector<EstimatorInput> all = inputs(s, 30.0);
+  std::size_t i = 0;
+  for (; i < all.size() && scan.calibration().groups.empty(); ++i) scan.push(all[i]);
+  ASSERT_FALSE(scan.calibration().groups.empty());
+  // Mid-epoch: a range of LRULPS #2 pushed, then a map with GRULPS 1 alone.
+  std::vector<Beacon> grulps;
+  for (const Beacon& b : s.beacon_list().map_frame) {
+    if (b.group == 1) grulps.push_back(b);
+  }
+  scan.set_beacon_map(BeaconMap(grulps));
+  EXPECT_TRUE(scan.calibration().groups.empty());
+  EXPECT_FALSE(scan.estimate());
+  int refused = 0;
+  for (; i < all.size(); ++i) refused += scan.push(all[i]).accepted ? 0 : 1;
+  EXPECT_GT(refused, 0);  // the LRULPS ranges: unknown_beacon now
+  EXPECT_TRUE(scan.calibration().groups.empty());
+}
+
+TEST(ScanEstimator, DuplicatesFloodsAndRangesFromTheFutureAreRefusedByReason) {
+  const sim::Scenario s = seed003();
+  ScanEstimator scan(config_of(s));
+  scan.set_beacon_map(BeaconMap(s.beacon_list()));
+  OdometrySample o;
+  o.stamp_ns = 1'000'000'000;
+  o.wheel_base_m = 0.33;
+  ASSERT_TRUE(scan.predict(o).accepted);
+  RangeMeasurement r;
+  r.stamp_ns = 1'005'000'000;
+  r.beacon_id = 11;
+  r.range_m = 4.0;
+  r.variance_m2 = 2.5e-5;
+  EXPECT_TRUE(scan.update(r).accepted);
+  EXPECT_EQ(scan.update(r).rejection, Rejection::kDuplicateRange);
+  RangeMeasurement ahead = r;
+  ahead.stamp_ns = 60'000'000'000;
+  EXPECT_EQ(scan.update(ahead).rejection, Rejection::kAheadOfOdometry);
+  // A flood: 100 beacons of one group heard within 1 ms (a hostile map, a broken gateway): the
+  // epoch takes 64 (no ULPS has more) and refuses the rest by reason.
+  std::vector<Beacon> big;
+  for (std::uint32_t id = 1; id <= 100; ++id) big.push_back({id, {0.01 * id, 0.0, 3.5}, 1});
+  ScanEstimator flooded(config_of(s));
+  flooded.set_beacon_map(BeaconMap(big));
+  ASSERT_TRUE(flooded.predict(o).accepted);
+  int refused = 0;
+  for (std::uint32_t id = 1; id <= 100; ++id) {
+    RangeMeasurement flood = r;
+    flood.beacon_id = id;
+    flood.stamp_ns = r.stamp_ns + id * 10'000;
+    const InputResult result = flooded.update(flood);
+    if (!result.accepted) {
+      EXPECT_EQ(result.rejection, Rejection::kTooManyRangesInEpoch);
+      ++refused;
+    }
+  }
+  EXPECT_EQ(refused, 36);
 }
 
 TEST(InputLog, KeepsEveryItemNewestFirstAndCopiesShareTheSealedPart) {
