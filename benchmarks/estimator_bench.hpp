@@ -62,7 +62,7 @@ inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t
   dc.max_range_m = s.max_range_m;
   dc.range_sigma_m = s.range_sigma_m;
   TofDecoder decoder(dc);
-  decoder.set_beacon_map(BeaconMap(s.beacons));
+  decoder.set_beacon_map(BeaconMap(s.beacon_list()));  // as the gateway publishes it: local groups in their frames
   std::vector<Input> out;
   for (const SourceEvent& e : events) {
     // As the localizer is given them.

@@ -41,7 +41,7 @@ int run_feeder(const dds::DdsOptions& dds, int robots, double seconds) {
       {dds::kRawTofTopic.name, "fleet_feeder.raw_tof.writer", dds::kRawTofTopic.reader_profile});
   auto odometry_writer = participant.writer<msg::OdometryPubSubType>(
       {dds::kOdometryTopic.name, "fleet_feeder.odometry.writer", dds::kOdometryTopic.reader_profile});
-  auto map = dds::to_msg(BeaconMap(scenario.beacons), "map");
+  auto map = dds::to_msg(BeaconMap(scenario.beacon_list()), "map");
   map_writer->write(&map);
   if (!dds::wait_for_matched_readers({tof_writer, odometry_writer}, std::chrono::seconds(10))) {
     std::fprintf(stderr, "feeder: no reader matched\n");

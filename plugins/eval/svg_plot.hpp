@@ -17,4 +17,13 @@ void write_trajectory_svg(const std::string& path, const std::string& title, con
 void write_error_svg(const std::string& path, const std::string& title,
                      const std::vector<ErrorPoint>& errors);
 
+// Empirical CDFs of several samples on one set of axes (seed 003 Fig. 11: the beacons' calibration
+// error for several d_min), each a labelled step line; x_label names the quantity and its unit.
+struct CdfSeries {
+  std::string label;
+  std::vector<double> values;
+};
+void write_cdf_svg(const std::string& path, const std::string& title, const std::string& x_label,
+                   const std::vector<CdfSeries>& series);
+
 }  // namespace beaconloc

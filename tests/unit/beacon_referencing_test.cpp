@@ -118,8 +118,9 @@ TEST(BeaconReferencing, Seed003PublishesItsLocalGroupsInTheirOwnFrames) {
   EXPECT_GT((b41->position_group_m.head<2>() - Eigen::Vector2d(0.3535533906, 0.3535533906)).norm(), 0.1);
 }
 
-// Today no estimator calibrates: on seed 003 every estimator that takes ranges refuses each range
-// to an LRULPS beacon, as uncalibrated (or, in a mode that uses no beacon, as unused), counted.
+// On seed 003 every estimator that takes ranges and does not calibrate refuses each range to an
+// LRULPS beacon, as uncalibrated (or, in a mode that uses no beacon, as unused), counted. `scan`
+// calibrates: its LRULPS ranges go to the group's own frame only (ScanEstimator.*).
 TEST(BeaconReferencing, OnSeed003NoEstimatorUsesAnUncalibratedBeacon) {
   const sim::Scenario s = seed003();
   std::uint64_t local_tofs = 0;
@@ -133,6 +134,7 @@ TEST(BeaconReferencing, OnSeed003NoEstimatorUsesAnUncalibratedBeacon) {
   for (const std::string& name : EstimatorRegistry::instance().names()) {
     SCOPED_TRACE(name);
     if (EstimatorRegistry::instance().reference_scenario(name).empty()) continue;  // a test double, not the product's
+    if (name == "scan") continue;  // the one that calibrates
     EstimatorConfig config;
     config.receivers = s.receivers;
     std::unique_ptr<Estimator> probe;

@@ -24,7 +24,7 @@ using Reason = EstimatorParameterError::Reason;
 // uhl_last2, one receiver and a map for ukf_lrf, one receiver at the centre for kleeman_iekf).
 EstimatorConfig config_for(const std::string& estimator, std::map<std::string, double> parameters) {
   EstimatorConfig c;
-  const bool one_at_centre = estimator.rfind("ukf_lrf", 0) == 0 || estimator == "kleeman_iekf";
+  const bool one_at_centre = estimator.rfind("ukf_lrf", 0) == 0 || estimator == "kleeman_iekf" || estimator == "scan";
   c.receivers = ReceiverArray::on_circle(one_at_centre ? 0.0 : 0.19, one_at_centre ? 1 : 3);
   c.occupancy_grid = std::make_shared<const OccupancyGrid>(Eigen::Vector2d::Zero(), 0.1, 40, 40);
   c.parameters = std::move(parameters);

@@ -109,6 +109,8 @@ const char* to_string(StartupCondition c) {
       return "heading_too_uncertain";
     case StartupCondition::kNoDoubleBurst:
       return "no_double_burst";
+    case StartupCondition::kNeedsMotion:
+      return "needs_motion";
   }
   return "unknown";
 }
@@ -147,6 +149,9 @@ std::string StartupWait::describe() const {
       break;
     case StartupCondition::kNoDoubleBurst:
       std::snprintf(text, sizeof text, "no double burst heard yet: the beacons cannot be named");
+      break;
+    case StartupCondition::kNeedsMotion:
+      std::snprintf(text, sizeof text, "the heading needs a second fix: moved %.2f m of %.2f m", value, limit);
       break;
   }
   return note.empty() ? std::string(text) : std::string(text) + " (" + note + ")";

@@ -38,6 +38,8 @@ const char* to_string(Rejection r) {
     case Rejection::kPulseTooFarAhead: return "pulse_too_far_ahead";
     case Rejection::kStartupFitFailed: return "startup_fit_failed";
     case Rejection::kDuplicatePulse: return "duplicate_pulse";
+    case Rejection::kDuplicateRange: return "duplicate_range";
+    case Rejection::kTooManyRangesInEpoch: return "too_many_ranges_in_epoch";
     case Rejection::kTooManyPulsesInSlot: return "too_many_pulses_in_slot";
     case Rejection::kBeaconMapUnusable: return "beacon_map_unusable";
     case Rejection::kTooLate: return "too_late";

@@ -81,6 +81,7 @@ enum class StartupCondition {
   kPositionTooUncertain,  // the fix's position sigma (value, m) above the limit
   kHeadingTooUncertain,   // the fix's heading sigma (value, rad) above the limit
   kNoDoubleBurst,         // pulses without ids: none heard yet from the beacon that marks the cycle
+  kNeedsMotion,           // the heading comes from two fixes: value m moved since the first of limit
 };
 const char* to_string(StartupCondition c);
 

@@ -37,6 +37,8 @@ enum class Rejection : std::uint8_t {
   kRangesWithoutOdometry,
   kNoBeaconToAssociate,
   kBeaconsUnused,  // an estimator mode that takes no beacon ranges
+  kDuplicateRange,         // a beacon's range at a stamp heard already (a duplicate delivery)
+  kTooManyRangesInEpoch,   // a flood: more ranges in one group's epoch than any group has beacons
   // Laser scans.
   kMalformedScan,
   kNoUsableBeams,

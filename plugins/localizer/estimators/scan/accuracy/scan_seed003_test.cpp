@@ -1,0 +1,199 @@
+// scan on the seed 003 setup (examples/scenarios/seed003_scan.yaml): the LRULPSs' beacons as
+// calibrated while driving, against the simulator's truth, and the robot's path in the map.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/decimal.hpp"
+#include "offline_run.hpp"
+#include "scan/scan_estimator.hpp"
+#include "sim/scenario_yaml.hpp"
+#include "svg_plot.hpp"
+
+namespace beaconloc::scan {
+namespace {
+
+sim::Scenario seed003() {
+  return sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/seed003_scan.yaml");
+}
+
+struct ScanRun {
+  BeaconCalibration calibration;
+  std::map<std::uint32_t, double> beacon_error_m;  // by beacon id
+  std::map<std::uint32_t, double> group_mean_error_m;
+  double position_rms_m = 0.0;
+  std::size_t poses = 0;
+};
+
+ScanRun run(const sim::Scenario& s, std::uint64_t seed, const std::map<std::string, double>& parameters,
+            bool verbose = false) {
+  EstimatorConfig config;
+  config.receivers = s.receivers;
+  config.parameters = parameters;
+  ScanEstimator scan(config);
+  const BeaconMap map(s.beacon_list());
+  scan.set_beacon_map(map);
+  TofDecoderConfig dc;
+  dc.min_range_m = s.min_range_m;
+  dc.max_range_m = s.max_range_m;
+  dc.range_sigma_m = s.range_sigma_m;
+  TofDecoder decoder(dc);
+  decoder.set_beacon_map(map);
+  ScanRun out;
+  double sum2 = 0.0;
+  double next_print_s = 0.0;
+  for (const SourceEvent& e : simulate(s, seed, s.duration_s)) {
+    const std::optional<EstimatorInput> input = estimator_input("robot", e, decoder, BeaconInput::kRanges);
+    if (!input) continue;
+    scan.push(*input);
+    if (e.kind != SourceEvent::Kind::kOdometry || !e.has_truth) continue;
+    const std::optional<PoseEstimate> est = scan.estimate();
+    if (!est) continue;
+    const double err = (est->pose_map_base.head<2>() - e.truth_map_base.head<2>()).norm();
+    sum2 += err * err;
+    ++out.poses;
+    if (verbose && ns_to_s(e.stamp_ns) >= next_print_s) {  // for a person looking into a run
+      std::printf("t %.1f truth %.2f %.2f est %.2f %.2f err %.3f sigma %.3f status %s calibrated %zu\n",
+                  ns_to_s(e.stamp_ns), e.truth_map_base.x(), e.truth_map_base.y(), est->pose_map_base.x(),
+                  est->pose_map_base.y(), err, std::sqrt(est->covariance.topLeftCorner<2, 2>().trace()),
+                  to_string(est->status), scan.calibration().groups.size());
+      for (std::uint32_t g = 3; g <= 4; ++g) {
+        const auto pc = scan.provisional_calibration(g);
+        if (pc) std::printf("   group %u provisional t_c %.3f %.3f %.3f %.3f err %.3f\n", g, pc->transform(0), pc->transform(1), pc->transform(2), pc->transform(3), pc->mean_error_m);
+      }
+      next_print_s += 5.0;
+    }
+  }
+  scan.finish();  // the recording ends
+  out.position_rms_m = out.poses ? std::sqrt(sum2 / static_cast<double>(out.poses)) : 0.0;
+  out.calibration = scan.calibration();
+  const BeaconMap truth(s.beacons);
+  for (const GroupCalibration& g : out.calibration.groups) {
+    double sum = 0.0;
+    for (const CalibratedBeacon& b : g.beacons) {
+      const double err = (b.position_map_m.head<2>() - truth.find(b.id)->position_map_m.head<2>()).norm();
+      out.beacon_error_m[b.id] = err;
+      sum += err;
+    }
+    out.group_mean_error_m[g.group] = sum / static_cast<double>(g.beacons.size());
+  }
+  return out;
+}
+
+// Runs per configuration: 4 in the suite (1 s); the paper's 100 with BEACONLOC_SEED003_RUNS=100
+// (docs/accuracy-seed003.md).
+int runs() {
+  const char* text = std::getenv("BEACONLOC_SEED003_RUNS");
+  if (!text) return 4;
+  std::int32_t n = 0;
+  if (parse_decimal(text, n) != NumberError::kNone || n < 1 || n > 10000) {
+    ADD_FAILURE() << "BEACONLOC_SEED003_RUNS must be a whole number in [1, 10000]";
+    return 4;
+  }
+  return n;
+}
+
+double mean_of(const std::vector<double>& v) {
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  return v.empty() ? 0.0 : sum / static_cast<double>(v.size());
+}
+
+// Sec. 4.1-4.2 and Fig. 13: the beacons' calibration error over the runs, EKF, UKF and
+// H-infinity side by side on the same runs (the same seeds), spherical and hyperbolic, with the
+// analytic transform (d_min = 2.5 m) and the numerical one (Sec. 4.2: 20 points), and the
+// inverse trajectory. Every LRULPS is calibrated on
+// every run, in the order the robot meets them; the first (beside GRULPS 1) to under 0.1 m on
+// average (100 runs: 0.066-0.067 m spherical, 0.080-0.081 m hyperbolic, analytic); the
+// worst is one of the two in the middle of the chain (LRULPS #4 or #5: groups 6 and 7), farthest
+// from both GRULPSs, as the paper finds (Sec. 2: "LRULPS #4", Sec. 4.1: "LRULPS 5 ... around the
+// middle of the trajectory"). The paper's means are < 0.2 m spherical and < 0.4 m hyperbolic:
+// hyperbolic is met (100 runs: 0.349-0.356 m), spherical is NOT (0.285-0.299 m; its bound below
+// is a regression guard): docs/accuracy-seed003.md has the table and what stands in the way.
+TEST(ScanOnSeed003, EveryGroupIsCalibratedAndTheWorstIsInTheMiddle) {
+  const sim::Scenario s = seed003();
+  const int n = runs();
+  for (const double numerical : {0.0, 1.0}) {
+  for (const double hyperbolic : {0.0, 1.0}) {
+    for (const double filter : {0.0, 1.0, 2.0}) {
+      std::map<std::uint32_t, std::vector<double>> by_group;  // each run's mean over the group's beacons
+      std::vector<double> all;
+      for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(n); ++seed) {
+        const ScanRun r = run(s, seed, {{"filter", filter}, {"hyperbolic", hyperbolic}, {"numerical_transform", numerical}});
+        ASSERT_EQ(r.calibration.groups.size(), s.local_group_frames_map.size())
+            << "seed " << seed << " filter " << filter << " hyperbolic " << hyperbolic;
+        std::vector<std::uint32_t> order;
+        for (const GroupCalibration& g : r.calibration.groups) order.push_back(g.group);
+        EXPECT_TRUE(std::is_sorted(order.begin(), order.end()));  // groups 3..9 lie along the path in id order
+        for (const auto& [g, e] : r.group_mean_error_m) by_group[g].push_back(e);
+        for (const auto& [id, e] : r.beacon_error_m) all.push_back(e);
+      }
+      std::uint32_t worst = 0;
+      double worst_mean = -1.0;
+      std::printf("%s %s %s, %d runs: mean beacon error %.3f m; by group (mean):",
+                  numerical > 0 ? "numerical" : "analytic", hyperbolic > 0 ? "hyperbolic" : "spherical",
+                  to_string(static_cast<FilterKind>(static_cast<int>(filter))), n, mean_of(all));
+      for (const auto& [g, errors] : by_group) {
+        std::printf(" %u: %.3f", g, mean_of(errors));
+        if (mean_of(errors) > worst_mean) {
+          worst_mean = mean_of(errors);
+          worst = g;
+        }
+      }
+      std::printf("; worst %u\n", worst);
+      EXPECT_TRUE(worst == 6 || worst == 7) << worst;
+      EXPECT_LT(mean_of(by_group[3]), 0.10);
+      // The paper's 0.4 m hyperbolic (analytic); the others regression guards (see above).
+      EXPECT_LT(mean_of(all), hyperbolic > 0 ? (numerical > 0 ? 0.50 : 0.40) : 0.35);
+    }
+  }
+  }
+}
+
+// Fig. 11: the CDF of every calibrated beacon's error for several d_min (analytic method,
+// spherical, EKF). A d_min the overlap between two groups cannot hold (5 m on this building:
+// the robot hears two groups at once over about 4 m) calibrates nothing: counted and said.
+// BEACONLOC_SEED003_CDF_SVG=FILE writes the plot.
+TEST(ScanOnSeed003, CalibrationErrorCdfOverDmin) {
+  const sim::Scenario s = seed003();
+  const int n = runs();
+  std::vector<CdfSeries> series;
+  std::map<double, std::vector<double>> errors;
+  for (const double d_min : {0.5, 1.5, 2.5, 5.0}) {
+    std::size_t groups = 0;
+    for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(n); ++seed) {
+      const ScanRun r = run(s, seed, {{"d_min_m", d_min}});
+      groups += r.calibration.groups.size();
+      for (const auto& [id, e] : r.beacon_error_m) errors[d_min].push_back(e);
+    }
+    std::vector<double> sorted = errors[d_min];
+    std::sort(sorted.begin(), sorted.end());
+    const auto quantile = [&](double q) {
+      return sorted.empty() ? std::nan("") : sorted[static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1))];
+    };
+    std::printf("d_min %.1f m, %d runs: %zu of %zu groups calibrated; beacon error median %.3f m, 95 %% %.3f m, "
+                "mean %.3f m\n",
+                d_min, n, groups, static_cast<std::size_t>(n) * s.local_group_frames_map.size(), quantile(0.5),
+                quantile(0.95), mean_of(sorted));
+    char label[64];
+    std::snprintf(label, sizeof label, "d_min = %.1f m (%zu beacons)", d_min, sorted.size());
+    series.push_back({label, sorted});
+  }
+  // As Fig. 11: two points 0.5 m apart give the worst transforms of the three that calibrate.
+  EXPECT_GT(mean_of(errors[0.5]), mean_of(errors[1.5]));
+  EXPECT_GT(mean_of(errors[0.5]), mean_of(errors[2.5]));
+  EXPECT_FALSE(errors[2.5].empty());
+  EXPECT_TRUE(errors[5.0].empty());  // this building's overlaps are shorter than 5 m
+  if (const char* svg = std::getenv("BEACONLOC_SEED003_CDF_SVG")) {
+    write_cdf_svg(svg, "seed 003: beacon calibration error over d_min", "beacon position error (m)", series);
+  }
+}
+
+}  // namespace
+}  // namespace beaconloc::scan
