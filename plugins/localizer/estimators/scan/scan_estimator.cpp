@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <set>
 #include <stdexcept>
 
 #include "beaconloc/core/chi_square.hpp"
@@ -82,6 +83,24 @@ void ScanEstimator::set_beacon_map(const BeaconMap& map) {
   back_in_grulps_since_ns_.reset();
   calibrated_since_grulps_ = 0;
   waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(beacons_for_a_fix(params_.geometry)), {}};
+}
+
+bool ScanEstimator::use_calibration(const BeaconCalibration& c) {
+  if (!check_calibration(c).ok()) return false;
+  std::map<std::uint32_t, std::set<std::uint32_t>> group_beacons;  // the map's locally referenced groups
+  for (const LocalBeacon& b : map().local_beacons()) group_beacons[b.group].insert(b.id);
+  for (const GroupCalibration& g : c.groups) {
+    const auto in_map = group_beacons.find(g.group);
+    if (in_map == group_beacons.end() || in_map->second.size() != g.beacons.size()) return false;
+    for (const CalibratedBeacon& b : g.beacons) {
+      if (in_map->second.count(b.id) == 0) return false;
+    }
+  }
+  for (const GroupCalibration& g : c.groups) {
+    local_.erase(g.group);
+    calibrate(g.group, g);
+  }
+  return true;
 }
 
 bool ScanEstimator::pairs_possible(StampNs now_ns) const {

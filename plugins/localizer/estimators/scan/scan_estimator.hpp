@@ -92,6 +92,13 @@ class ScanEstimator final : public EstimatorBase {
 
   // The groups calibrated so far (each once its overlap ended), in the order they were.
   const BeaconCalibration& calibration() const { return calibration_; }
+  // Calibrations found before (by another robot, or by this one before a restart: what the
+  // BeaconCalibration topic and the calibration file will carry): each group in it is used at
+  // once as calibrated, its beacons at their calibrated map positions, with no calibration drive.
+  // Refused whole (false) when check_calibration refuses it or it does not fit the map: a group
+  // the map does not hold as locally referenced, or a group's beacons not exactly the map's.
+  // Given after the map (a new map drops it with everything else).
+  bool use_calibration(const BeaconCalibration& calibration);
   // Groups whose overlap is under way: the transform so far (nullopt before one exists).
   std::optional<GroupCalibration> provisional_calibration(std::uint32_t group) const;
 

@@ -276,6 +276,59 @@ TEST(ScanEstimator, DuplicatesFloodsAndRangesFromTheFutureAreRefusedByReason) {
   EXPECT_EQ(refused, 36);
 }
 
+// Acceptance (issue 16): a second robot given the first one's calibration localizes in the
+// calibrated groups at once, with no calibration drive of its own; its accuracy there is reported.
+TEST(ScanEstimator, ASecondRobotGivenTheCalibrationLocalizesInTheCalibratedGroupsAtOnce) {
+  const sim::Scenario s = seed003();
+  const BeaconMap map(s.beacon_list());
+  ScanEstimator first(config_of(s));
+  first.set_beacon_map(map);
+  for (const EstimatorInput& in : inputs(s, s.duration_s)) first.push(in);
+  first.finish();
+  const BeaconCalibration calibration = first.calibration();
+  ASSERT_EQ(calibration.groups.size(), s.local_group_frames_map.size());
+
+  // The second robot: another seed (other noise), the same drive.
+  ScanEstimator second(config_of(s));
+  second.set_beacon_map(map);
+  ASSERT_TRUE(second.use_calibration(calibration));
+  TofDecoderConfig dc;
+  dc.max_range_m = s.max_range_m;
+  dc.range_sigma_m = s.range_sigma_m;
+  TofDecoder decoder(dc);
+  decoder.set_beacon_map(map);
+  double sum2 = 0.0;
+  std::size_t scored = 0, ok = 0;
+  for (const SourceEvent& e : simulate(s, 2, s.duration_s)) {
+    if (auto in = estimator_input("robot2", e, decoder, BeaconInput::kRanges)) second.push(*in);
+    // Scored from LRULPS #1 to #7 (x > 9 m on the first wing, y < 25 m on the second).
+    const bool in_lrulps = e.truth_map_base.x() > 9.0 && e.truth_map_base.y() < 25.0;
+    if (e.kind != SourceEvent::Kind::kOdometry || !e.has_truth || !in_lrulps || !second.estimate()) continue;
+    sum2 += (second.estimate()->pose_map_base.head<2>() - e.truth_map_base.head<2>()).squaredNorm();
+    ++scored;
+    ok += second.status() == PoseStatus::kOk ? 1 : 0;
+  }
+  ASSERT_GT(scored, 8000u);  // ~100 s of the 148 s drive at 100 Hz
+  const double rms_m = std::sqrt(sum2 / static_cast<double>(scored));
+  std::printf("second robot in the calibrated groups (seed 2, 100 Hz poses): position RMS %.3f m, %.0f %% ok\n",
+              rms_m, 100.0 * static_cast<double>(ok) / static_cast<double>(scored));
+  EXPECT_LT(rms_m, 0.5);
+  EXPECT_GT(ok, scored * 9 / 10);
+  // It calibrated nothing itself: its calibration is the one it was given.
+  EXPECT_EQ(second.calibration(), calibration);
+
+  // A calibration that does not fit the map is refused whole.
+  BeaconCalibration wrong = calibration;
+  wrong.groups[0].beacons.pop_back();
+  ScanEstimator third(config_of(s));
+  third.set_beacon_map(map);
+  EXPECT_FALSE(third.use_calibration(wrong));
+  wrong = calibration;
+  wrong.groups[0].group = 1;  // a GRULPS
+  EXPECT_FALSE(third.use_calibration(wrong));
+  EXPECT_TRUE(third.calibration().groups.empty());
+}
+
 TEST(InputLog, KeepsEveryItemNewestFirstAndCopiesShareTheSealedPart) {
   InputLog<int> log;
   for (int i = 0; i < 1000; ++i) log.push_back(i);
