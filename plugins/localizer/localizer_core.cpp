@@ -14,6 +14,43 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
   const auto probe = EstimatorRegistry::instance().create(estimator_name_, config_);
   uses_laser_ = probe->uses_laser();
   beacon_input_ = probe->beacon_input();
+  uses_calibration_ = probe->uses_calibration();
+}
+
+bool LocalizerCore::on_calibration(const BeaconCalibration& calibration) {
+  BeaconCalibration merged = calibration_;
+  const CalibrationCheck check = check_calibration(calibration);
+  if (check.ok() && !merge_calibration(merged, calibration)) return false;  // nothing new
+  // Merged, two groups may claim one beacon: refused as the calibration that made it so.
+  const CalibrationCheck merged_check = check.ok() ? check_calibration(merged) : check;
+  if (!merged_check.ok()) {
+    counts_.reject(std::string("calibration.") + to_string(merged_check.problem));
+    return false;
+  }
+  counts_.accept();
+  calibration_ = std::move(merged);
+  ++calibration_revision_;
+  for (auto& [id, r] : robots_) give_calibration(r);
+  return true;
+}
+
+std::vector<std::uint32_t> LocalizerCore::calibration_groups_unfit() const {
+  std::vector<std::uint32_t> unfit;
+  if (!map_.empty()) calibration_fitting(calibration_, map_, &unfit);
+  return unfit;
+}
+
+void LocalizerCore::give_calibration(Robot& r) {
+  if (!uses_calibration_ || map_.empty() || calibration_.groups.empty()) return;
+  const BeaconCalibration fitting = calibration_fitting(calibration_, map_);
+  if (fitting.groups.empty()) return;
+  if (!r.fusion.use_calibration(fitting)) counts_.reject("calibration.refused_by_estimator");
+  r.fusion.take_calibration_update();  // its own again: nothing new to the site
+}
+
+void LocalizerCore::take_calibration(Robot& r) {
+  if (!uses_calibration_) return;
+  if (const std::optional<BeaconCalibration> found = r.fusion.take_calibration_update()) on_calibration(*found);
 }
 
 bool LocalizerCore::on_beacon_map(const BeaconList& beacons) {
@@ -30,6 +67,7 @@ void LocalizerCore::set_beacon_map(const BeaconMap& map) {
   for (auto& [id, r] : robots_) {
     if (first) {
       r.fusion.set_beacon_map(map_);  // nothing it holds came from beacons yet
+      give_calibration(r);
     } else {
       restart_robot(r);
     }
@@ -42,6 +80,7 @@ InputResult LocalizerCore::restart_robot(Robot& r, const OdometrySample* next) {
   restart.initial_pose.reset();  // not the run's start pose
   r = Robot(EstimatorRegistry::instance().create(estimator_name_, restart));
   r.fusion.set_beacon_map(map_);
+  give_calibration(r);
   const InputResult result = next ? r.fusion.push(*next) : InputResult::ok();
   if (!r.fusion.estimator().localizes_from_beacons() && before && publishable(*before) && result.accepted) {
     // Placed where it was, less sure by 0.1 m and 0.1 rad (standard deviations).
@@ -65,6 +104,7 @@ LocalizerCore::Robot* LocalizerCore::robot(const std::string& robot_id, const ch
     it = robots_.emplace(robot_id, Robot(EstimatorRegistry::instance().create(estimator_name_, config_)))
              .first;
     it->second.fusion.set_beacon_map(map_);
+    give_calibration(it->second);
   }
   return &it->second;
 }
@@ -75,6 +115,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
   if (!r) return std::nullopt;
   r->odometry_deadlines_missed = 0;  // the bus delivers odometry again
   InputResult result = r->fusion.push(odometry);
+  take_calibration(*r);
   for (const auto& reason : r->fusion.take_deferred_rejections()) counts_.reject("deferred.", reason);
   if (!result.accepted && result.rejection == Rejection::kOutOfOrderOdometry && clock_jumped_back(*r, odometry)) {
     // The robot's clock stepped back (a restarted gateway replaying, a reset clock): what the
@@ -187,6 +228,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_measurement(const std::string& 
   if (is_beacon_input(input, beacon_input_)) r->ranges_silent = false;
   const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
   const InputResult result = r->fusion.push(std::move(input));
+  take_calibration(*r);
   if (!result.accepted) {
     counts_.reject(kind + ".", *result.rejection);
     return std::nullopt;

@@ -55,6 +55,20 @@ class LocalizerCore {
   bool has_beacon_map() const { return !map_.empty(); }
   const BeaconMap& beacon_map() const { return map_; }
   std::uint64_t beacon_map_changes() const { return beacon_map_changes_; }
+  // The site's beacon calibration (seed 003: locally referenced groups calibrated by a robot),
+  // gathered from every source: a calibration received (the BeaconCalibration topic, a file) and
+  // what the robots it serves find. Each group's newest calibration replaces the one before
+  // (merge_calibration). The part that fits the map (calibration_fitting) is given to every
+  // robot's estimator that uses calibrations, at once and whenever one is made or restarted: a
+  // robot localizes in the groups others calibrated without a calibration drive of its own. A
+  // calibration is refused whole, counted as calibration.<problem>, when check_calibration
+  // refuses it (or the site's with it merged). Returns whether the site's calibration changed.
+  bool on_calibration(const BeaconCalibration& calibration);
+  const BeaconCalibration& calibration() const { return calibration_; }
+  // Counts the changes of calibration(): the participant publishes and keeps it when it moved.
+  std::uint64_t calibration_revision() const { return calibration_revision_; }
+  // The groups of calibration() the map does not fit (never used), for the Diagnostics.
+  std::vector<std::uint32_t> calibration_groups_unfit() const;
   // Any input: odometry to on_odometry; a range, scan or raw TOF fused at its stamp (nothing for
   // a kind the estimator does not take: see on_range, on_laser, on_raw_tof).
   std::optional<LocalizerOutput> on_input(const std::string& robot_id, EstimatorInput input);
@@ -144,6 +158,11 @@ class LocalizerCore {
   // A range, scan or raw time of flight: fused at its stamp, counted under its kind
   // ("range.", "laser.", "raw_tof."), the corrected pose returned when it changed.
   std::optional<LocalizerOutput> on_measurement(const std::string& robot_id, EstimatorInput input);
+  // The site's calibration that fits the map, to the robot's estimator (if it uses one).
+  void give_calibration(Robot& r);
+  // What the robot's estimator calibrated since last asked, into the site's calibration (and so
+  // to every other robot).
+  void take_calibration(Robot& r);
   std::optional<LocalizerOutput> correction_output(const std::string& robot_id, Robot& r,
                                                    const std::optional<PoseEstimate>& before);
 
@@ -156,6 +175,9 @@ class LocalizerCore {
   std::map<std::string, Robot> robots_;
   RejectionCounter counts_;
   std::uint64_t beacon_map_changes_ = 0;
+  bool uses_calibration_ = false;
+  BeaconCalibration calibration_;  // checked, groups sorted by id
+  std::uint64_t calibration_revision_ = 0;
 };
 
 }  // namespace beaconloc

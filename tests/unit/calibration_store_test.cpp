@@ -18,6 +18,7 @@
 #include <random>
 #include <sstream>
 
+#include "beaconloc/core/beacon_map.hpp"
 #include "beaconloc/core/calibration_store.hpp"
 
 namespace beaconloc {
@@ -185,8 +186,51 @@ TEST(CalibrationStore, EveryDamagedFileIsRefusedByReason) {
   EXPECT_EQ(r.problem, CalibrationFileProblem::kTooLarge);
 }
 
+// What several sources found, gathered: each group's newest replaces the one before; the groups
+// sorted, so that the same knowledge compares equal whatever order it came in.
+TEST(BeaconCalibration, MergedGroupByGroupTheNewestReplacingTheOlder) {
+  BeaconCalibration site;
+  const BeaconCalibration first = calibration(5, 2, 3, 0.0);   // groups 5, 6
+  BeaconCalibration later = calibration(4, 2, 3, 1.0);         // groups 4, 5: 5 found again
+  EXPECT_TRUE(merge_calibration(site, first));
+  EXPECT_EQ(site, first);
+  EXPECT_FALSE(merge_calibration(site, first));  // nothing new
+  EXPECT_TRUE(merge_calibration(site, later));
+  ASSERT_EQ(site.groups.size(), 3u);
+  EXPECT_EQ(site.groups[0].group, 4u);
+  EXPECT_EQ(site.groups[1].group, 5u);
+  EXPECT_EQ(site.groups[2].group, 6u);
+  EXPECT_EQ(site.groups[1].transform, later.groups[1].transform);  // the newer group 5
+  EXPECT_EQ(site.groups[2].transform, first.groups[1].transform);
+  BeaconCalibration other_order;
+  merge_calibration(other_order, BeaconCalibration{{site.groups[2], site.groups[0]}});
+  merge_calibration(other_order, BeaconCalibration{{site.groups[1]}});
+  EXPECT_EQ(other_order, site);
+}
+
+// Only the groups the map holds as locally referenced, with exactly its beacons, are used.
+TEST(BeaconCalibration, OnlyTheGroupsThatFitTheMapAreUsed) {
+  BeaconList beacons;
+  beacons.map_frame.push_back({1, Eigen::Vector3d(0.0, 0.0, 3.0), 1});  // group 1: globally referenced
+  beacons.map_frame.push_back({2, Eigen::Vector3d(1.0, 0.0, 3.0), 1});
+  beacons.map_frame.push_back({3, Eigen::Vector3d(0.0, 1.0, 3.0), 1});
+  for (std::uint32_t id = 10; id < 13; ++id) beacons.group_frame.push_back({id, 2, Eigen::Vector3d(id, 0.0, 3.0)});
+  for (std::uint32_t id = 20; id < 23; ++id) beacons.group_frame.push_back({id, 3, Eigen::Vector3d(id, 0.0, 3.0)});
+  const BeaconMap map(beacons);
+  BeaconCalibration c = calibration(1, 4, 3, 0.0);  // groups 1-4, beacons 1-12
+  c.groups[1].beacons[0].id = 10;                   // group 2: 10, 5, 6 (not the map's 10, 11, 12)
+  for (std::size_t i = 0; i < 3; ++i) c.groups[2].beacons[i].id = static_cast<std::uint32_t>(20 + i);  // group 3: fits
+  std::vector<std::uint32_t> unfit;
+  const BeaconCalibration fitting = calibration_fitting(c, map, &unfit);
+  ASSERT_EQ(fitting.groups.size(), 1u);
+  EXPECT_EQ(fitting.groups[0].group, 3u);
+  EXPECT_EQ(unfit, (std::vector<std::uint32_t>{1, 2, 4}));  // a GRULPS, other beacons, no such group
+}
+
 // A child saves two calibrations in turn as fast as it can; it is killed (SIGKILL: no handler, no
-// flush) at a random instant, 60 times. Each time the file holds one of the two, whole.
+// flush) at a random instant, at least 60 times and until 5 kills have landed inside a save
+// (between the temporary's open and its rename; fewer land there on a loaded machine, where a
+// forked child takes longer to start saving). Each time the file holds one of the two, whole.
 TEST(CalibrationStore, AWriterKilledWhileItWritesLeavesTheOldCalibrationOrTheNew) {
   const std::string path = temporary_path("killed.calibration");
   const BeaconCalibration a = calibration(3, 10, 20, 0.0);  // 200 beacons: ~15 kB a write
@@ -197,18 +241,30 @@ TEST(CalibrationStore, AWriterKilledWhileItWritesLeavesTheOldCalibrationOrTheNew
   const auto save_us =
       std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - began).count();
   std::mt19937_64 rng(5);
-  std::uniform_int_distribution<long> delay_us(0, 3 * std::max<long>(static_cast<long>(save_us), 1000));
+  std::uniform_int_distribution<long> delay_us(0, 4 * std::max<long>(static_cast<long>(save_us), 1000));
   int saw_a = 0, saw_b = 0;
   int inside_save = 0;       // kills between the temporary's open and its rename
   int torn_temporaries = 0;  // of those, while the temporary was half written
-  for (int round = 0; round < 60; ++round) {
+  constexpr int kMinRounds = 60, kMaxRounds = 600, kInsideSaveWanted = 5;
+  int rounds = 0;
+  for (int round = 0; round < kMaxRounds && (round < kMinRounds || inside_save < kInsideSaveWanted); ++round) {
+    ++rounds;
+    int started[2];  // the child says when it begins to save: the kill's delay counts from there
+    ASSERT_EQ(::pipe(started), 0);
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
+      ::close(started[0]);
+      const char go = 1;
+      if (::write(started[1], &go, 1) != 1) ::_exit(4);
       for (int i = 0;; ++i) {
         if (!save_calibration(path, i % 2 == 0 ? b : a).ok()) ::_exit(3);
       }
     }
+    ::close(started[1]);
+    char go = 0;
+    ASSERT_EQ(::read(started[0], &go, 1), 1);
+    ::close(started[0]);
     ::usleep(static_cast<useconds_t>(delay_us(rng)));
     ASSERT_EQ(::kill(child, SIGKILL), 0);
     int status = 0;
@@ -230,14 +286,15 @@ TEST(CalibrationStore, AWriterKilledWhileItWritesLeavesTheOldCalibrationOrTheNew
       FAIL() << "round " << round << ": a calibration that was never written";
     }
   }
-  std::printf("killed 60 writers: the file held the first calibration %d times, the second %d times; %d killed "
+  std::printf("one save %ld us; killed %d writers: the file held the first calibration %d times, the second %d times; %d killed "
               "between the temporary's open and its rename, %d of them with the temporary half written\n",
-              saw_a, saw_b, inside_save, torn_temporaries);
-  EXPECT_GT(inside_save, 0);
+              static_cast<long>(save_us), rounds, saw_a, saw_b, inside_save, torn_temporaries);
+  EXPECT_GE(inside_save, kInsideSaveWanted);
   // The test can tell: a writer that overwrites the file in place, killed the same way, leaves
   // torn files.
-  int torn = 0;
-  for (int round = 0; round < 30; ++round) {
+  int torn = 0, in_place_rounds = 0;
+  for (int round = 0; round < 10 * kMinRounds && (round < kMinRounds / 2 || torn == 0); ++round) {
+    ++in_place_rounds;
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
@@ -253,7 +310,7 @@ TEST(CalibrationStore, AWriterKilledWhileItWritesLeavesTheOldCalibrationOrTheNew
     CalibrationFileResult r;
     if (!load_calibration(path, &r)) ++torn;
   }
-  std::printf("killed 30 writers that overwrite in place: %d torn files\n", torn);
+  std::printf("killed %d writers that overwrite in place: %d torn files\n", in_place_rounds, torn);
   EXPECT_GT(torn, 0);
   // A save after them all.
   ASSERT_TRUE(save_calibration(path, b).ok());

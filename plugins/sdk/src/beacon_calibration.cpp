@@ -1,6 +1,8 @@
 #include "beaconloc/core/beacon_calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 
 #include "beaconloc/core/beacon_map.hpp"
@@ -93,6 +95,40 @@ CalibrationCheck check_calibration(const BeaconCalibration& calibration) {
     if (p != CalibrationProblem::kNone) return {p, g.group};
   }
   return {};
+}
+
+bool merge_calibration(BeaconCalibration& site, const BeaconCalibration& update) {
+  const BeaconCalibration before = site;
+  for (const GroupCalibration& g : update.groups) {
+    const auto it = std::find_if(site.groups.begin(), site.groups.end(),
+                                 [&](const GroupCalibration& held) { return held.group == g.group; });
+    if (it == site.groups.end()) {
+      site.groups.push_back(g);
+    } else {
+      *it = g;
+    }
+  }
+  std::sort(site.groups.begin(), site.groups.end(),
+            [](const GroupCalibration& a, const GroupCalibration& b) { return a.group < b.group; });
+  return !(site == before);
+}
+
+BeaconCalibration calibration_fitting(const BeaconCalibration& calibration, const BeaconMap& map,
+                                      std::vector<std::uint32_t>* unfit) {
+  std::map<std::uint32_t, std::set<std::uint32_t>> group_beacons;  // the map's locally referenced groups
+  for (const LocalBeacon& b : map.local_beacons()) group_beacons[b.group].insert(b.id);
+  BeaconCalibration fitting;
+  for (const GroupCalibration& g : calibration.groups) {
+    std::set<std::uint32_t> ids;
+    for (const CalibratedBeacon& b : g.beacons) ids.insert(b.id);
+    const auto in_map = group_beacons.find(g.group);
+    if (in_map != group_beacons.end() && in_map->second == ids && ids.size() == g.beacons.size()) {
+      fitting.groups.push_back(g);
+    } else if (unfit) {
+      unfit->push_back(g.group);
+    }
+  }
+  return fitting;
 }
 
 }  // namespace beaconloc

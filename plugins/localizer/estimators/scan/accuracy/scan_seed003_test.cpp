@@ -39,12 +39,7 @@ ScanRun run(const sim::Scenario& s, std::uint64_t seed, const std::map<std::stri
   ScanEstimator scan(config);
   const BeaconMap map(s.beacon_list());
   scan.set_beacon_map(map);
-  TofDecoderConfig dc;
-  dc.min_range_m = s.min_range_m;
-  dc.max_range_m = s.max_range_m;
-  dc.range_sigma_m = s.range_sigma_m;
-  TofDecoder decoder(dc);
-  decoder.set_beacon_map(map);
+  TofDecoder decoder = scenario_decoder(s);
   ScanRun out;
   double sum2 = 0.0;
   double next_print_s = 0.0;

@@ -14,6 +14,8 @@
 
 namespace beaconloc {
 
+class BeaconMap;
+
 struct CalibratedBeacon {
   std::uint32_t id = 0;
   Eigen::Vector3d position_map_m = Eigen::Vector3d::Zero();  // z as the group frame gives it
@@ -57,5 +59,19 @@ struct CalibrationCheck {
   std::string describe() const;  // "group 4: bad_covariance"
 };
 CalibrationCheck check_calibration(const BeaconCalibration& calibration);
+
+// What a site knows is gathered from several sources (robots calibrating, the bus, a file): each
+// group in `update` replaces the site's calibration of that group, or is added; the groups stay
+// sorted by id, so that equal knowledge compares equal. Returns whether `site` changed. Both are
+// checked calibrations; the result is one too unless two groups name one beacon (checked by the
+// caller: check_calibration of the result).
+bool merge_calibration(BeaconCalibration& site, const BeaconCalibration& update);
+
+// The groups of a calibration that fit the map: each a group the map holds as locally
+// referenced, with exactly the map's beacons of that group. A group that does not fit (its group
+// unknown, globally referenced, or its beacons not the map's: the map changed since) goes to
+// *unfit, when given: it is never used, as its beacons are not the map's beacons.
+BeaconCalibration calibration_fitting(const BeaconCalibration& calibration, const BeaconMap& map,
+                                      std::vector<std::uint32_t>* unfit = nullptr);
 
 }  // namespace beaconloc
