@@ -19,7 +19,10 @@
 namespace beaconloc::scan {
 namespace {
 
+// The seed 003 scenario, or BEACONLOC_SEED003_SCENARIO's (a copy with one assumption changed, to
+// see what the figures depend on: docs/accuracy-seed003.md).
 sim::Scenario seed003() {
+  if (const char* file = std::getenv("BEACONLOC_SEED003_SCENARIO")) return sim::load_scenario_file(file);
   return sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/seed003_scan.yaml");
 }
 
