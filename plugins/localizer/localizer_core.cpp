@@ -18,39 +18,69 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
 }
 
 bool LocalizerCore::on_calibration(const BeaconCalibration& calibration) {
-  BeaconCalibration merged = calibration_;
+  if (!uses_calibration_) return false;  // its estimator calibrates nothing and uses nothing
   const CalibrationCheck check = check_calibration(calibration);
-  if (check.ok() && !merge_calibration(merged, calibration)) return false;  // nothing new
-  // Merged, two groups may claim one beacon: refused as the calibration that made it so.
-  const CalibrationCheck merged_check = check.ok() ? check_calibration(merged) : check;
-  if (!merged_check.ok()) {
-    counts_.reject(std::string("calibration.") + to_string(merged_check.problem));
+  if (!check.ok()) {
+    counts_.reject(std::string("calibration.") + to_string(check.problem));
     return false;
   }
   counts_.accept();
-  calibration_ = std::move(merged);
+  return merge_into_site(calibration, nullptr);
+}
+
+bool LocalizerCore::merge_into_site(const BeaconCalibration& calibration, const Robot* source) {
+  bool changed = false;
+  for (const GroupCalibration& g : calibration.groups) {
+    const BeaconCalibration one{{g}};
+    if (!map_.empty() && calibration_fitting(one, map_).groups.empty()) {
+      counts_.reject("calibration.not_on_map");  // another site's, or measured on another map
+      continue;
+    }
+    BeaconCalibration merged = calibration_;
+    if (!merge_calibration(merged, one)) continue;  // held already, or a better one is
+    // A beacon another group holds: the group is refused, the rest goes on.
+    if (const CalibrationCheck check = check_calibration(merged); !check.ok()) {
+      counts_.reject(std::string("calibration.") + to_string(check.problem));
+      continue;
+    }
+    calibration_ = std::move(merged);
+    changed = true;
+  }
+  if (!changed) return false;
   ++calibration_revision_;
-  for (auto& [id, r] : robots_) give_calibration(r);
+  // Not back to the robot that found it: what it holds is its own, and the copies its late
+  // measurements replay from must find it again themselves (the backwards drive counts on it).
+  for (auto& [id, r] : robots_) {
+    if (&r != source) give_calibration(r);
+  }
   return true;
 }
 
-std::vector<std::uint32_t> LocalizerCore::calibration_groups_unfit() const {
+void LocalizerCore::drop_calibration_off_the_map() {
   std::vector<std::uint32_t> unfit;
-  if (!map_.empty()) calibration_fitting(calibration_, map_, &unfit);
-  return unfit;
+  const BeaconCalibration fitting = calibration_fitting(calibration_, map_, &unfit);
+  if (unfit.empty()) return;
+  counts_.reject("calibration.not_on_map", unfit.size());
+  calibration_ = fitting;
+  ++calibration_revision_;
 }
 
 void LocalizerCore::give_calibration(Robot& r) {
   if (!uses_calibration_ || map_.empty() || calibration_.groups.empty()) return;
-  const BeaconCalibration fitting = calibration_fitting(calibration_, map_);
-  if (fitting.groups.empty()) return;
-  if (!r.fusion.use_calibration(fitting)) counts_.reject("calibration.refused_by_estimator");
-  r.fusion.take_calibration_update();  // its own again: nothing new to the site
+  if (!r.fusion.use_calibration(calibration_)) counts_.reject("calibration.refused_by_estimator");
+  r.fusion.take_calibration_update();  // the site's again: nothing new to it
 }
 
 void LocalizerCore::take_calibration(Robot& r) {
   if (!uses_calibration_) return;
-  if (const std::optional<BeaconCalibration> found = r.fusion.take_calibration_update()) on_calibration(*found);
+  // Its own finding, checked as anything else: an estimator's fault is counted, not spread.
+  if (const std::optional<BeaconCalibration> found = r.fusion.take_calibration_update()) {
+    if (const CalibrationCheck check = check_calibration(*found); !check.ok()) {
+      counts_.reject(std::string("calibration.") + to_string(check.problem));
+    } else {
+      merge_into_site(*found, &r);
+    }
+  }
 }
 
 bool LocalizerCore::on_beacon_map(const BeaconList& beacons) {
@@ -64,6 +94,9 @@ void LocalizerCore::set_beacon_map(const BeaconMap& map) {
   const bool first = map_.empty();
   map_ = map;
   if (!first) ++beacon_map_changes_;
+  // Groups calibrated on another map (or received before the first) that this one does not fit
+  // are dropped: their beacons are not this map's.
+  drop_calibration_off_the_map();
   for (auto& [id, r] : robots_) {
     if (first) {
       r.fusion.set_beacon_map(map_);  // nothing it holds came from beacons yet

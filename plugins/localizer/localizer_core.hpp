@@ -57,18 +57,20 @@ class LocalizerCore {
   std::uint64_t beacon_map_changes() const { return beacon_map_changes_; }
   // The site's beacon calibration (seed 003: locally referenced groups calibrated by a robot),
   // gathered from every source: a calibration received (the BeaconCalibration topic, a file) and
-  // what the robots it serves find. Each group's newest calibration replaces the one before
-  // (merge_calibration). The part that fits the map (calibration_fitting) is given to every
-  // robot's estimator that uses calibrations, at once and whenever one is made or restarted: a
-  // robot localizes in the groups others calibrated without a calibration drive of its own. A
-  // calibration is refused whole, counted as calibration.<problem>, when check_calibration
-  // refuses it (or the site's with it merged). Returns whether the site's calibration changed.
+  // what the robots it serves find. A group's better calibration replaces the one held
+  // (merge_calibration: the surer beacons; every localizer keeps the same). It is given to every
+  // robot's estimator, at once and whenever one is made or restarted (not back to the robot that
+  // found it): a robot localizes in the groups others calibrated without a calibration drive of
+  // its own. Refused and counted as calibration.<problem>: a calibration check_calibration
+  // refuses (whole); a group that would put a beacon in two groups, or that does not fit the map
+  // (calibration_fitting: calibration.not_on_map). Groups received before the first map are kept
+  // until it comes; a map drops those that do not fit it. An estimator that uses no calibration
+  // takes none (false). Returns whether the site's calibration changed.
   bool on_calibration(const BeaconCalibration& calibration);
   const BeaconCalibration& calibration() const { return calibration_; }
+  bool uses_calibration() const { return uses_calibration_; }  // its estimator's (Estimator::uses_calibration)
   // Counts the changes of calibration(): the participant publishes and keeps it when it moved.
   std::uint64_t calibration_revision() const { return calibration_revision_; }
-  // The groups of calibration() the map does not fit (never used), for the Diagnostics.
-  std::vector<std::uint32_t> calibration_groups_unfit() const;
   // Any input: odometry to on_odometry; a range, scan or raw TOF fused at its stamp (nothing for
   // a kind the estimator does not take: see on_range, on_laser, on_raw_tof).
   std::optional<LocalizerOutput> on_input(const std::string& robot_id, EstimatorInput input);
@@ -158,7 +160,11 @@ class LocalizerCore {
   // A range, scan or raw time of flight: fused at its stamp, counted under its kind
   // ("range.", "laser.", "raw_tof."), the corrected pose returned when it changed.
   std::optional<LocalizerOutput> on_measurement(const std::string& robot_id, EstimatorInput input);
-  // The site's calibration that fits the map, to the robot's estimator (if it uses one).
+  // A checked calibration's groups into the site's, each refused on its own (see on_calibration);
+  // the site's calibration to every robot but `source` when it changed.
+  bool merge_into_site(const BeaconCalibration& calibration, const Robot* source);
+  void drop_calibration_off_the_map();
+  // The site's calibration (it fits the map) to the robot's estimator, if it uses one.
   void give_calibration(Robot& r);
   // What the robot's estimator calibrated since last asked, into the site's calibration (and so
   // to every other robot).

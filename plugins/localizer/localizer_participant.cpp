@@ -70,6 +70,10 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       state_writer_(participant_.writer<msg::EstimatorStatePubSubType>(dds::kEstimatorStateTopic)),
       calibration_writer_(participant_.writer<msg::BeaconCalibrationPubSubType>(dds::kBeaconCalibrationTopic)) {
   own_calibration_writer_ = dds::writer_id(calibration_writer_->get_instance_handle());
+  if (!options_.calibration_file.empty() && !core_.uses_calibration()) {
+    throw CalibrationFileError("calibration file " + options_.calibration_file + ": the estimator " +
+                               core_.estimator_name() + " uses no beacon calibration");
+  }
   if (const std::optional<BeaconCalibration> kept = kept_calibration(options_.calibration_file)) {
     core_.on_calibration(*kept);
     calibration_shared_revision_ = core_.calibration_revision();  // in the file already
@@ -84,6 +88,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
     // The writers left agree: their map is the site's, whichever arrived last before.
     if (const auto agreed = map_sources_.agreed_map(); agreed && !(*agreed == core_.beacon_map())) {
       core_.set_beacon_map(*agreed);
+      share_calibration();
     }
   };
   readers_.push_back(participant_.subscribe_with_info<msg::BeaconMapPubSubType>(
@@ -93,6 +98,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
         if (core_.on_beacon_map(dds::from_msg(m))) {
           map_sources_.on_map(dds::writer_id(info.publication_handle), core_.beacon_map());
           map_frame_id_ = m.frame_id();
+          share_calibration();  // a new map drops the groups it does not hold
         }
       },
       map_events));
@@ -101,8 +107,20 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
   readers_.push_back(participant_.subscribe_with_info<msg::BeaconCalibrationPubSubType>(
       dds::kBeaconCalibrationTopic,
       [this](const msg::BeaconCalibration& m, const eprosima::fastdds::dds::SampleInfo& info) {
+        // Before the lock: Fast DDS may hand its own sample back on the writing thread, which
+        // holds mutex_ (share_calibration).
         if (dds::writer_id(info.publication_handle) == own_calibration_writer_) return;
         std::lock_guard<std::mutex> lock(mutex_);
+        std::size_t beacons = 0;
+        for (const msg::GroupCalibration& g : m.groups()) beacons += g.beacons().size();
+        if (m.groups().size() > kMaxBeacons || beacons > kMaxBeacons) {
+          ++calibrations_refused_too_large_;  // not even converted: no site has that many
+          return;
+        }
+        if (m.frame_id() != map_frame_id_) {
+          ++calibrations_refused_other_frame_;  // positions in a frame that is not the map's
+          return;
+        }
         core_.on_calibration(dds::from_msg(m));
         share_calibration();
       }));
@@ -297,11 +315,6 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   }
   if (!core_.calibration().groups.empty()) {
     message += "; beacon calibration: " + std::to_string(core_.calibration().groups.size()) + " group(s)";
-    if (const auto unfit = core_.calibration_groups_unfit(); !unfit.empty()) {
-      // Calibrated on another map (its beacons are not this map's): never used.
-      message += ", " + std::to_string(unfit.size()) + " not fitting the beacon map (first: group " +
-                 std::to_string(unfit.front()) + "), unused";
-    }
   }
   if (!calibration_save_error_.empty()) {
     // The newest calibration would not survive a restart.
@@ -329,6 +342,8 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   counts.reject("odometry.sequence_restart", sequence_restarts_);
   counts.reject("diagnostics.too_many_robots", peer_reports_refused_);
   counts.reject("calibration_file.write_failed", calibration_saves_failed_);
+  counts.reject("calibration.too_many_beacons", calibrations_refused_too_large_);
+  counts.reject("calibration.other_frame", calibrations_refused_other_frame_);
   auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, deadline_misses_.load(),
                                  status, message);
   d.writers_lost(odometry_writers_lost_.load() + range_writers_lost_.load());

@@ -93,6 +93,8 @@ class LocalizerParticipant {
   std::uint64_t calibration_shared_revision_ = 0;  // core_.calibration_revision() last shared
   std::string own_calibration_writer_;             // its own calibration comes back to its reader
   std::uint64_t calibration_saves_failed_ = 0;
+  std::uint64_t calibrations_refused_too_large_ = 0;  // more groups or beacons than kMaxBeacons
+  std::uint64_t calibrations_refused_other_frame_ = 0;  // frame_id not the beacon map's
   std::string calibration_save_error_;             // the last failure, while the newest is unsaved
   // The entities, owned: the readers, declared last, stop first, before what they use goes.
   dds::Participant participant_;

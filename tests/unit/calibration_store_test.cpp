@@ -186,12 +186,13 @@ TEST(CalibrationStore, EveryDamagedFileIsRefusedByReason) {
   EXPECT_EQ(r.problem, CalibrationFileProblem::kTooLarge);
 }
 
-// What several sources found, gathered: each group's newest replaces the one before; the groups
-// sorted, so that the same knowledge compares equal whatever order it came in.
-TEST(BeaconCalibration, MergedGroupByGroupTheNewestReplacingTheOlder) {
+// What several sources found, gathered: a group's surer calibration replaces the one held (then
+// the later one, then by value); the groups sorted, so that the same knowledge compares equal
+// whatever order it came in.
+TEST(BeaconCalibration, MergedGroupByGroupTheSurerReplacingTheOther) {
   BeaconCalibration site;
   const BeaconCalibration first = calibration(5, 2, 3, 0.0);   // groups 5, 6
-  BeaconCalibration later = calibration(4, 2, 3, 1.0);         // groups 4, 5: 5 found again
+  BeaconCalibration later = calibration(4, 2, 3, 1.0);         // groups 4, 5: 5 found again, later, as sure
   EXPECT_TRUE(merge_calibration(site, first));
   EXPECT_EQ(site, first);
   EXPECT_FALSE(merge_calibration(site, first));  // nothing new
@@ -200,31 +201,64 @@ TEST(BeaconCalibration, MergedGroupByGroupTheNewestReplacingTheOlder) {
   EXPECT_EQ(site.groups[0].group, 4u);
   EXPECT_EQ(site.groups[1].group, 5u);
   EXPECT_EQ(site.groups[2].group, 6u);
-  EXPECT_EQ(site.groups[1].transform, later.groups[1].transform);  // the newer group 5
+  EXPECT_EQ(site.groups[1].transform, later.groups[1].transform);  // as sure, and later
   EXPECT_EQ(site.groups[2].transform, first.groups[1].transform);
-  BeaconCalibration other_order;
-  merge_calibration(other_order, BeaconCalibration{{site.groups[2], site.groups[0]}});
-  merge_calibration(other_order, BeaconCalibration{{site.groups[1]}});
-  EXPECT_EQ(other_order, site);
+  // Group 5 earlier but surer: it wins; a later, looser one does not.
+  GroupCalibration surer = first.groups[0];
+  surer.stamp_ns -= 1000;
+  for (auto& b : surer.beacons) b.covariance_m2 *= 0.5;
+  EXPECT_TRUE(merge_calibration(site, BeaconCalibration{{surer}}));
+  EXPECT_EQ(BeaconCalibration{{site.groups[1]}}, BeaconCalibration{{surer}});
+  EXPECT_FALSE(merge_calibration(site, later));
+  // Whatever order the versions come in, the same result.
+  const std::vector<BeaconCalibration> versions{first, later, BeaconCalibration{{surer}}};
+  for (const auto& order : std::vector<std::vector<int>>{{0, 1, 2}, {2, 1, 0}, {1, 2, 0}, {2, 0, 1}}) {
+    BeaconCalibration other;
+    for (int k : order) merge_calibration(other, versions[static_cast<std::size_t>(k)]);
+    EXPECT_EQ(other, site);
+  }
 }
 
-// Only the groups the map holds as locally referenced, with exactly its beacons, are used.
+// Only the groups the map holds as locally referenced, with exactly its beacons, each where the
+// group's transform puts the map's beacon (eq. 41-43), are used.
 TEST(BeaconCalibration, OnlyTheGroupsThatFitTheMapAreUsed) {
   BeaconList beacons;
   beacons.map_frame.push_back({1, Eigen::Vector3d(0.0, 0.0, 3.0), 1});  // group 1: globally referenced
   beacons.map_frame.push_back({2, Eigen::Vector3d(1.0, 0.0, 3.0), 1});
   beacons.map_frame.push_back({3, Eigen::Vector3d(0.0, 1.0, 3.0), 1});
-  for (std::uint32_t id = 10; id < 13; ++id) beacons.group_frame.push_back({id, 2, Eigen::Vector3d(id, 0.0, 3.0)});
-  for (std::uint32_t id = 20; id < 23; ++id) beacons.group_frame.push_back({id, 3, Eigen::Vector3d(id, 0.0, 3.0)});
+  for (std::uint32_t id = 10; id < 13; ++id) beacons.group_frame.push_back({id, 2, Eigen::Vector3d(id, 0.5, 3.0)});
+  for (std::uint32_t id = 20; id < 23; ++id) beacons.group_frame.push_back({id, 3, Eigen::Vector3d(id, -0.5, 3.0)});
   const BeaconMap map(beacons);
-  BeaconCalibration c = calibration(1, 4, 3, 0.0);  // groups 1-4, beacons 1-12
-  c.groups[1].beacons[0].id = 10;                   // group 2: 10, 5, 6 (not the map's 10, 11, 12)
-  for (std::size_t i = 0; i < 3; ++i) c.groups[2].beacons[i].id = static_cast<std::uint32_t>(20 + i);  // group 3: fits
+  // Each group of the calibration placed by its transform from the map's group frame.
+  const auto placed = [&](std::uint32_t group, std::vector<std::uint32_t> ids) {
+    GroupCalibration g;
+    g.group = group;
+    g.transform << 0.6, 0.8, 10.0, -3.0;
+    for (std::uint32_t id : ids) {
+      CalibratedBeacon b;
+      b.id = id;
+      const LocalBeacon* local = map.find_local(id);
+      const Eigen::Vector3d p = local ? local->position_group_m : Eigen::Vector3d(1.0, 2.0, 3.0);
+      b.position_map_m << 0.6 * p.x() - 0.8 * p.y() + 10.0, 0.8 * p.x() + 0.6 * p.y() - 3.0, p.z();
+      g.beacons.push_back(b);
+    }
+    return g;
+  };
+  BeaconCalibration c;
+  c.groups.push_back(placed(1, {1, 2, 3}));     // a GRULPS
+  c.groups.push_back(placed(2, {10, 11}));      // short of the map's beacon 12
+  c.groups.push_back(placed(3, {20, 21, 22}));  // fits
+  c.groups.push_back(placed(4, {30, 31, 32}));  // no such group
+  GroupCalibration moved = placed(2, {10, 11, 12});
+  moved.group = 2;
+  moved.beacons[2].position_map_m.y() += 0.002;  // 2 mm off its transform: the frame re-surveyed
+  c.groups.push_back(moved);
   std::vector<std::uint32_t> unfit;
   const BeaconCalibration fitting = calibration_fitting(c, map, &unfit);
   ASSERT_EQ(fitting.groups.size(), 1u);
   EXPECT_EQ(fitting.groups[0].group, 3u);
-  EXPECT_EQ(unfit, (std::vector<std::uint32_t>{1, 2, 4}));  // a GRULPS, other beacons, no such group
+  EXPECT_EQ(unfit, (std::vector<std::uint32_t>{1, 2, 4, 2}));
+  EXPECT_EQ(calibration_fitting(BeaconCalibration{{placed(2, {10, 11, 12})}}, map).groups.size(), 1u);
 }
 
 // A child saves two calibrations in turn as fast as it can; it is killed (SIGKILL: no handler, no

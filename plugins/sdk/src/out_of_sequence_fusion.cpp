@@ -30,9 +30,13 @@ void OutOfSequenceFusion::set_beacon_map(const BeaconMap& map) {
 bool OutOfSequenceFusion::use_calibration(const BeaconCalibration& calibration) {
   const bool taken = estimator_->use_calibration(calibration);
   if (!taken) return false;
+  // The copies hold it as given, not as news: a replay from one does not report it again.
   base_->use_calibration(calibration);
+  base_->take_calibration_update();
   for (auto& e : history_) {
-    if (e.checkpoint) e.checkpoint->use_calibration(calibration);
+    if (!e.checkpoint) continue;
+    e.checkpoint->use_calibration(calibration);
+    e.checkpoint->take_calibration_update();
   }
   collect_outputs();
   return true;

@@ -60,8 +60,8 @@ class OutOfSequenceFusion {
   // copy a replay may start from, so that a late measurement does not roll it back. Whether the
   // estimator took it.
   bool use_calibration(const BeaconCalibration& calibration);
-  // The estimator's newest calibration when it changed since last asked (a replay that finds it
-  // again reports it again).
+  // The estimator's newest calibration when it changed since last asked (a replay that finds a
+  // calibration of its own again reports it again; one given by use_calibration is not news).
   std::optional<BeaconCalibration> take_calibration_update();
   std::vector<Estimator::Association> take_associations();
   std::vector<Rejection> take_deferred_rejections();
