@@ -363,7 +363,8 @@ TEST_F(CalibrationOnTheBus, ADamagedCalibrationFileStopsTheStartWithItsReason) {
 
 // A calibration that cannot be kept (here: the file's directory does not exist; a full disk or
 // a read-only one alike) is said so: counted, and the localizer degraded with the reason, while
-// the calibration stays in use and on the bus.
+// the calibration stays in use and on the bus. A sample in another frame is refused; a file for
+// an estimator that uses none stops the start.
 TEST_F(CalibrationOnTheBus, ACalibrationThatCannotBeSavedIsSaidSo) {
   const std::string file = path("no/such/dir/site.calibration");
   DiagnosticsRecorder diagnostics(dds_);
@@ -390,7 +391,22 @@ TEST_F(CalibrationOnTheBus, ACalibrationThatCannotBeSavedIsSaidSo) {
   EXPECT_NE(reported.message().find("beacon calibration not saved to " + file), std::string::npos)
       << reported.message();
   EXPECT_NE(reported.message().find("beacon calibration: 1 group(s)"), std::string::npos) << reported.message();
+  // A calibration in another frame than the map's is refused and counted, never merged.
+  GroupCalibration other = g;
+  other.group = 4;
+  for (auto& b : other.beacons) b.id += 10;
+  auto in_odom = dds::to_msg(BeaconCalibration{{other}}, "odom");
+  writer->write(&in_odom);
+  const auto refused = wait_for_diagnostics(diagnostics, kScanLocalizer, [&](const msg::Diagnostics& d) {
+    return rejected_count(d, "calibration.other_frame") >= 1;
+  });
+  EXPECT_EQ(rejected_count(refused, "calibration.other_frame"), 1u) << refused.message();
+  EXPECT_NE(refused.message().find("beacon calibration: 1 group(s)"), std::string::npos) << refused.message();
   ASSERT_NO_FATAL_FAILURE(stop_cleanly(localizer1, "localizer"));
+  // An estimator that uses no calibration is not given a file to keep one in.
+  const auto [code, output] = run_command(command("localizer", {"--calibration-file", file}), 30s);
+  EXPECT_EQ(code, 2) << output;
+  EXPECT_NE(output.find("the estimator range_ekf uses no beacon calibration"), std::string::npos) << output;
 }
 
 }  // namespace
