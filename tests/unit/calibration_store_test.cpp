@@ -269,37 +269,42 @@ TEST(CalibrationStore, AWriterKilledWhileItWritesLeavesTheOldCalibrationOrTheNew
   const std::string path = temporary_path("killed.calibration");
   const BeaconCalibration a = calibration(3, 10, 20, 0.0);  // 200 beacons: ~15 kB a write
   const BeaconCalibration b = calibration(3, 10, 20, 1.0);
-  // The kills land anywhere in the child's first few saves, however fast this build saves.
-  const auto began = std::chrono::steady_clock::now();
   ASSERT_TRUE(save_calibration(path, a).ok());
-  const auto save_us =
-      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - began).count();
   std::mt19937_64 rng(5);
-  std::uniform_int_distribution<long> delay_us(0, 4 * std::max<long>(static_cast<long>(save_us), 1000));
+  std::uniform_real_distribution<double> fraction(0.0, 2.0);
   int saw_a = 0, saw_b = 0;
   int inside_save = 0;       // kills between the temporary's open and its rename
   int torn_temporaries = 0;  // of those, while the temporary was half written
   constexpr int kMinRounds = 60, kMaxRounds = 600, kInsideSaveWanted = 5;
   int rounds = 0;
+  long save_us = 0;  // one save of the child's, as the parent saw it (the newest round's)
   for (int round = 0; round < kMaxRounds && (round < kMinRounds || inside_save < kInsideSaveWanted); ++round) {
     ++rounds;
-    int started[2];  // the child says when it begins to save: the kill's delay counts from there
-    ASSERT_EQ(::pipe(started), 0);
+    // The child says each save it finished. After its first two (however slow a forked,
+    // instrumented or loaded child starts), the kill lands within the next two saves' time: the
+    // child is saving all along.
+    int saved[2];
+    ASSERT_EQ(::pipe(saved), 0);
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
-      ::close(started[0]);
-      const char go = 1;
-      if (::write(started[1], &go, 1) != 1) ::_exit(4);
+      ::close(saved[0]);
       for (int i = 0;; ++i) {
         if (!save_calibration(path, i % 2 == 0 ? b : a).ok()) ::_exit(3);
+        const char done = 1;
+        if (i < 2 && ::write(saved[1], &done, 1) != 1) ::_exit(4);
       }
     }
-    ::close(started[1]);
-    char go = 0;
-    ASSERT_EQ(::read(started[0], &go, 1), 1);
-    ::close(started[0]);
-    ::usleep(static_cast<useconds_t>(delay_us(rng)));
+    ::close(saved[1]);
+    char done = 0;
+    ASSERT_EQ(::read(saved[0], &done, 1), 1);
+    const auto first = std::chrono::steady_clock::now();
+    ASSERT_EQ(::read(saved[0], &done, 1), 1);
+    save_us = std::max<long>(
+        1, static_cast<long>(
+               std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - first).count()));
+    ::close(saved[0]);
+    ::usleep(static_cast<useconds_t>(fraction(rng) * static_cast<double>(save_us)));
     ASSERT_EQ(::kill(child, SIGKILL), 0);
     int status = 0;
     ASSERT_EQ(::waitpid(child, &status, 0), child);
@@ -320,7 +325,7 @@ TEST(CalibrationStore, AWriterKilledWhileItWritesLeavesTheOldCalibrationOrTheNew
       FAIL() << "round " << round << ": a calibration that was never written";
     }
   }
-  std::printf("one save %ld us; killed %d writers: the file held the first calibration %d times, the second %d times; %d killed "
+  std::printf("one save of the child %ld us; killed %d writers: the file held the first calibration %d times, the second %d times; %d killed "
               "between the temporary's open and its rename, %d of them with the temporary half written\n",
               static_cast<long>(save_us), rounds, saw_a, saw_b, inside_save, torn_temporaries);
   EXPECT_GE(inside_save, kInsideSaveWanted);
@@ -337,7 +342,7 @@ TEST(CalibrationStore, AWriterKilledWhileItWritesLeavesTheOldCalibrationOrTheNew
         in_place << format_calibration(i % 2 == 0 ? b : a);
       }
     }
-    ::usleep(static_cast<useconds_t>(delay_us(rng)));
+    ::usleep(static_cast<useconds_t>(fraction(rng) * static_cast<double>(save_us)));
     ASSERT_EQ(::kill(child, SIGKILL), 0);
     int status = 0;
     ASSERT_EQ(::waitpid(child, &status, 0), child);
