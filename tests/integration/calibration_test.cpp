@@ -208,10 +208,16 @@ TEST_F(CalibrationOnTheBus, CalibratedOnceThenEveryRobotUsesItAfterARestartOfEve
       },
       30s))
       << localizer2.log() << localizer3.log();
-  ChildProcess gateway2(gateway("robot2", 2, scenario_.duration_s, path("truth2.csv")), path("gateway2.log"));
-  ChildProcess gateway3(gateway("robot3", 3, scenario_.duration_s, path("truth3.csv")), path("gateway3.log"));
-  ASSERT_NO_FATAL_FAILURE(finish_gateway(gateway2, poses, "robot2", path("truth2.csv")));
-  ASSERT_NO_FATAL_FAILURE(finish_gateway(gateway3, poses, "robot3", path("truth3.csv")));
+  // One robot after the other (both at once, under the sanitizers on a loaded machine, left a
+  // localizer short of its robot's last pose within the wait, 1 run of 5).
+  {
+    ChildProcess gateway2(gateway("robot2", 2, scenario_.duration_s, path("truth2.csv")), path("gateway2.log"));
+    ASSERT_NO_FATAL_FAILURE(finish_gateway(gateway2, poses, "robot2", path("truth2.csv")));
+  }
+  {
+    ChildProcess gateway3(gateway("robot3", 3, scenario_.duration_s, path("truth3.csv")), path("gateway3.log"));
+    ASSERT_NO_FATAL_FAILURE(finish_gateway(gateway3, poses, "robot3", path("truth3.csv")));
+  }
   for (const auto& [robot, truth] : {std::pair{"robot2", "truth2.csv"}, std::pair{"robot3", "truth3.csv"}}) {
     // Every group calibrated from its first pose on, before it reached any of them.
     EXPECT_EQ(first_calibrated_groups(states, robot), static_cast<double>(kept->groups.size())) << robot;
