@@ -57,12 +57,7 @@ inline std::vector<Input> simulated_inputs(const sim::Scenario& s, std::uint64_t
   sim::SimSource source(s, seed);
   std::vector<SourceEvent> events;
   source.advance(s_to_ns(duration_s), events);
-  TofDecoderConfig dc;
-  dc.min_range_m = s.min_range_m;
-  dc.max_range_m = s.max_range_m;
-  dc.range_sigma_m = s.range_sigma_m;
-  TofDecoder decoder(dc);
-  decoder.set_beacon_map(BeaconMap(s.beacon_list()));  // as the gateway publishes it: local groups in their frames
+  TofDecoder decoder = scenario_decoder(s);
   std::vector<Input> out;
   for (const SourceEvent& e : events) {
     // As the localizer is given them.

@@ -75,7 +75,10 @@ OptionSet localizer_option_set(LocalizerSettings& o, bool standalone) {
       .reals("--initial-pose", o.initial_pose, 3,
              "X Y YAW: where the robot starts, for estimators placed by hand (default in run and demo: "
              "the scenario's start)",
-             real_in(-kMaxMapCoordinateM, kMaxMapCoordinateM));
+             real_in(-kMaxMapCoordinateM, kMaxMapCoordinateM))
+      .text("--calibration-file", o.calibration_file,
+            "keep the site's beacon calibration (seed 003's calibrated groups) in this file: read at start, "
+            "written whenever it changes, so it survives a restart");
   if (!standalone) return set;
   set.text("--robot", o.robot, "serve only this robot id (default: every robot)")
       .real("--receiver-radius-m", o.receiver_radius_m, "without --receivers: receivers on a circle of this radius",

@@ -231,7 +231,8 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
   if (!config.occupancy_grid && source.scenario && source.scenario->map) {  // no --out: no map file
     config.occupancy_grid = std::make_shared<const OccupancyGrid>(*source.scenario->map);
   }
-  LocalizerParticipant localizer(o.dds, LocalizerCore(o.localizer.estimator, config, o.localizer.robot));
+  LocalizerParticipant localizer(o.dds, LocalizerCore(o.localizer.estimator, config, o.localizer.robot),
+                                 {o.localizer.calibration_file});
   std::unique_ptr<bridge::BridgeParticipant> ros2_bridge;
   if (o.bridge) {
     bridge::BridgeOptions b = *o.bridge;

@@ -49,6 +49,7 @@ struct LocalizerSettings {
   double receiver_height_m = 0.0;
   std::string map_file;              // ROS map_server YAML; empty: none (or the scenario's, in run)
   std::vector<double> initial_pose;  // x, y, yaw; empty: none (or the scenario's start, in run)
+  std::string calibration_file;      // the site's beacon calibration kept here; empty: on the bus only
 
   // Throws std::invalid_argument naming the bad option. fallback: receivers when none given.
   EstimatorConfig config(const std::optional<ReceiverArray>& fallback = std::nullopt) const;

@@ -14,6 +14,73 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
   const auto probe = EstimatorRegistry::instance().create(estimator_name_, config_);
   uses_laser_ = probe->uses_laser();
   beacon_input_ = probe->beacon_input();
+  uses_calibration_ = probe->uses_calibration();
+}
+
+bool LocalizerCore::on_calibration(const BeaconCalibration& calibration) {
+  if (!uses_calibration_) return false;  // its estimator calibrates nothing and uses nothing
+  const CalibrationCheck check = check_calibration(calibration);
+  if (!check.ok()) {
+    counts_.reject(std::string("calibration.") + to_string(check.problem));
+    return false;
+  }
+  counts_.accept();
+  return merge_into_site(calibration, nullptr);
+}
+
+bool LocalizerCore::merge_into_site(const BeaconCalibration& calibration, const Robot* source) {
+  bool changed = false;
+  for (const GroupCalibration& g : calibration.groups) {
+    const BeaconCalibration one{{g}};
+    if (!map_.empty() && calibration_fitting(one, map_).groups.empty()) {
+      counts_.reject("calibration.not_on_map");  // another site's, or measured on another map
+      continue;
+    }
+    BeaconCalibration merged = calibration_;
+    if (!merge_calibration(merged, one)) continue;  // held already, or a better one is
+    // A beacon another group holds: the group is refused, the rest goes on.
+    if (const CalibrationCheck check = check_calibration(merged); !check.ok()) {
+      counts_.reject(std::string("calibration.") + to_string(check.problem));
+      continue;
+    }
+    calibration_ = std::move(merged);
+    changed = true;
+  }
+  if (!changed) return false;
+  ++calibration_revision_;
+  // Not back to the robot that found it: what it holds is its own, and the copies its late
+  // measurements replay from must find it again themselves (the backwards drive counts on it).
+  for (auto& [id, r] : robots_) {
+    if (&r != source) give_calibration(r);
+  }
+  return true;
+}
+
+void LocalizerCore::drop_calibration_off_the_map() {
+  std::vector<std::uint32_t> unfit;
+  const BeaconCalibration fitting = calibration_fitting(calibration_, map_, &unfit);
+  if (unfit.empty()) return;
+  counts_.reject("calibration.not_on_map", unfit.size());
+  calibration_ = fitting;
+  ++calibration_revision_;
+}
+
+void LocalizerCore::give_calibration(Robot& r) {
+  if (!uses_calibration_ || map_.empty() || calibration_.groups.empty()) return;
+  if (!r.fusion.use_calibration(calibration_)) counts_.reject("calibration.refused_by_estimator");
+  r.fusion.take_calibration_update();  // the site's again: nothing new to it
+}
+
+void LocalizerCore::take_calibration(Robot& r) {
+  if (!uses_calibration_) return;
+  // Its own finding, checked as anything else: an estimator's fault is counted, not spread.
+  if (const std::optional<BeaconCalibration> found = r.fusion.take_calibration_update()) {
+    if (const CalibrationCheck check = check_calibration(*found); !check.ok()) {
+      counts_.reject(std::string("calibration.") + to_string(check.problem));
+    } else {
+      merge_into_site(*found, &r);
+    }
+  }
 }
 
 bool LocalizerCore::on_beacon_map(const BeaconList& beacons) {
@@ -27,9 +94,13 @@ void LocalizerCore::set_beacon_map(const BeaconMap& map) {
   const bool first = map_.empty();
   map_ = map;
   if (!first) ++beacon_map_changes_;
+  // Groups calibrated on another map (or received before the first) that this one does not fit
+  // are dropped: their beacons are not this map's.
+  drop_calibration_off_the_map();
   for (auto& [id, r] : robots_) {
     if (first) {
       r.fusion.set_beacon_map(map_);  // nothing it holds came from beacons yet
+      give_calibration(r);
     } else {
       restart_robot(r);
     }
@@ -42,6 +113,7 @@ InputResult LocalizerCore::restart_robot(Robot& r, const OdometrySample* next) {
   restart.initial_pose.reset();  // not the run's start pose
   r = Robot(EstimatorRegistry::instance().create(estimator_name_, restart));
   r.fusion.set_beacon_map(map_);
+  give_calibration(r);
   const InputResult result = next ? r.fusion.push(*next) : InputResult::ok();
   if (!r.fusion.estimator().localizes_from_beacons() && before && publishable(*before) && result.accepted) {
     // Placed where it was, less sure by 0.1 m and 0.1 rad (standard deviations).
@@ -65,6 +137,7 @@ LocalizerCore::Robot* LocalizerCore::robot(const std::string& robot_id, const ch
     it = robots_.emplace(robot_id, Robot(EstimatorRegistry::instance().create(estimator_name_, config_)))
              .first;
     it->second.fusion.set_beacon_map(map_);
+    give_calibration(it->second);
   }
   return &it->second;
 }
@@ -75,6 +148,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_odometry(const std::string& rob
   if (!r) return std::nullopt;
   r->odometry_deadlines_missed = 0;  // the bus delivers odometry again
   InputResult result = r->fusion.push(odometry);
+  take_calibration(*r);
   for (const auto& reason : r->fusion.take_deferred_rejections()) counts_.reject("deferred.", reason);
   if (!result.accepted && result.rejection == Rejection::kOutOfOrderOdometry && clock_jumped_back(*r, odometry)) {
     // The robot's clock stepped back (a restarted gateway replaying, a reset clock): what the
@@ -187,6 +261,7 @@ std::optional<LocalizerOutput> LocalizerCore::on_measurement(const std::string& 
   if (is_beacon_input(input, beacon_input_)) r->ranges_silent = false;
   const std::optional<PoseEstimate> before = r->fusion.estimator().estimate();
   const InputResult result = r->fusion.push(std::move(input));
+  take_calibration(*r);
   if (!result.accepted) {
     counts_.reject(kind + ".", *result.rejection);
     return std::nullopt;

@@ -55,6 +55,22 @@ class LocalizerCore {
   bool has_beacon_map() const { return !map_.empty(); }
   const BeaconMap& beacon_map() const { return map_; }
   std::uint64_t beacon_map_changes() const { return beacon_map_changes_; }
+  // The site's beacon calibration (seed 003: locally referenced groups calibrated by a robot),
+  // gathered from every source: a calibration received (the BeaconCalibration topic, a file) and
+  // what the robots it serves find. A group's better calibration replaces the one held
+  // (merge_calibration: the surer beacons; every localizer keeps the same). It is given to every
+  // robot's estimator, at once and whenever one is made or restarted (not back to the robot that
+  // found it): a robot localizes in the groups others calibrated without a calibration drive of
+  // its own. Refused and counted as calibration.<problem>: a calibration check_calibration
+  // refuses (whole); a group that would put a beacon in two groups, or that does not fit the map
+  // (calibration_fitting: calibration.not_on_map). Groups received before the first map are kept
+  // until it comes; a map drops those that do not fit it. An estimator that uses no calibration
+  // takes none (false). Returns whether the site's calibration changed.
+  bool on_calibration(const BeaconCalibration& calibration);
+  const BeaconCalibration& calibration() const { return calibration_; }
+  bool uses_calibration() const { return uses_calibration_; }  // its estimator's (Estimator::uses_calibration)
+  // Counts the changes of calibration(): the participant publishes and keeps it when it moved.
+  std::uint64_t calibration_revision() const { return calibration_revision_; }
   // Any input: odometry to on_odometry; a range, scan or raw TOF fused at its stamp (nothing for
   // a kind the estimator does not take: see on_range, on_laser, on_raw_tof).
   std::optional<LocalizerOutput> on_input(const std::string& robot_id, EstimatorInput input);
@@ -144,6 +160,15 @@ class LocalizerCore {
   // A range, scan or raw time of flight: fused at its stamp, counted under its kind
   // ("range.", "laser.", "raw_tof."), the corrected pose returned when it changed.
   std::optional<LocalizerOutput> on_measurement(const std::string& robot_id, EstimatorInput input);
+  // A checked calibration's groups into the site's, each refused on its own (see on_calibration);
+  // the site's calibration to every robot but `source` when it changed.
+  bool merge_into_site(const BeaconCalibration& calibration, const Robot* source);
+  void drop_calibration_off_the_map();
+  // The site's calibration (it fits the map) to the robot's estimator, if it uses one.
+  void give_calibration(Robot& r);
+  // What the robot's estimator calibrated since last asked, into the site's calibration (and so
+  // to every other robot).
+  void take_calibration(Robot& r);
   std::optional<LocalizerOutput> correction_output(const std::string& robot_id, Robot& r,
                                                    const std::optional<PoseEstimate>& before);
 
@@ -156,6 +181,9 @@ class LocalizerCore {
   std::map<std::string, Robot> robots_;
   RejectionCounter counts_;
   std::uint64_t beacon_map_changes_ = 0;
+  bool uses_calibration_ = false;
+  BeaconCalibration calibration_;  // checked, groups sorted by id
+  std::uint64_t calibration_revision_ = 0;
 };
 
 }  // namespace beaconloc

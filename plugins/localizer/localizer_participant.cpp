@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "beaconloc/core/calibration_store.hpp"
 #include "beaconloc/dds/convert.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
 
@@ -37,18 +38,48 @@ void LocalizerParticipant::subscribe_beacon_measurements(const dds::TopicSpec& t
           // order: a correction at once, not with the next odometry sample.
           std::lock_guard<std::mutex> lock(mutex_);
           if (auto corrected = fuse(m)) publish(*corrected);
+          share_calibration();
         }
         ++ranges_processed_;
       },
       events));
 }
 
-LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core)
+namespace {
+// The calibration kept in the file, if any; throws CalibrationFileError for a file that exists
+// and cannot be used (nothing is guessed from a damaged file).
+std::optional<BeaconCalibration> kept_calibration(const std::string& path) {
+  if (path.empty()) return std::nullopt;
+  CalibrationFileResult result;
+  std::optional<BeaconCalibration> kept = load_calibration(path, &result);
+  if (result.problem == CalibrationFileProblem::kMissing) return std::nullopt;  // none kept yet
+  if (!kept) {
+    throw CalibrationFileError("calibration file " + path + ": " + to_string(result.problem) + ": " + result.detail);
+  }
+  return kept;
+}
+}  // namespace
+
+LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core,
+                                           LocalizerParticipantOptions options)
     : core_(std::move(core)),
       conflicts_(std::chrono::duration_cast<std::chrono::nanoseconds>(dds::kDiagnosticsSilentAfter).count()),
+      options_(std::move(options)),
       participant_(dds, "beaconloc.localizer." + core_.estimator_name()),
       pose_writer_(participant_.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic)),
-      state_writer_(participant_.writer<msg::EstimatorStatePubSubType>(dds::kEstimatorStateTopic)) {
+      state_writer_(participant_.writer<msg::EstimatorStatePubSubType>(dds::kEstimatorStateTopic)),
+      calibration_writer_(participant_.writer<msg::BeaconCalibrationPubSubType>(dds::kBeaconCalibrationTopic)) {
+  own_calibration_writer_ = dds::writer_id(calibration_writer_->get_instance_handle());
+  if (!options_.calibration_file.empty() && !core_.uses_calibration()) {
+    throw CalibrationFileError("calibration file " + options_.calibration_file + ": the estimator " +
+                               core_.estimator_name() + " uses no beacon calibration");
+  }
+  if (const std::optional<BeaconCalibration> kept = kept_calibration(options_.calibration_file)) {
+    core_.on_calibration(*kept);
+    calibration_shared_revision_ = core_.calibration_revision();  // in the file already
+    auto m = dds::to_msg(core_.calibration(), map_frame_id_);
+    calibration_writer_->write(&m);
+  }
   // Every writer's map is remembered: two live gateways with different maps are reported.
   dds::ReaderEvents<msg::BeaconMap> map_events;
   map_events.on_writer_gone = [this](const std::string& writer) {
@@ -57,6 +88,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
     // The writers left agree: their map is the site's, whichever arrived last before.
     if (const auto agreed = map_sources_.agreed_map(); agreed && !(*agreed == core_.beacon_map())) {
       core_.set_beacon_map(*agreed);
+      share_calibration();
     }
   };
   readers_.push_back(participant_.subscribe_with_info<msg::BeaconMapPubSubType>(
@@ -65,9 +97,33 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
         std::lock_guard<std::mutex> lock(mutex_);
         if (core_.on_beacon_map(dds::from_msg(m))) {
           map_sources_.on_map(dds::writer_id(info.publication_handle), core_.beacon_map());
+          map_frame_id_ = m.frame_id();
+          share_calibration();  // a new map drops the groups it does not hold
         }
       },
       map_events));
+  // Other localizers' calibrations (its own comes back too: not news). Each sample is a site's
+  // whole calibration; its groups replace the ones held (LocalizerCore::on_calibration).
+  readers_.push_back(participant_.subscribe_with_info<msg::BeaconCalibrationPubSubType>(
+      dds::kBeaconCalibrationTopic,
+      [this](const msg::BeaconCalibration& m, const eprosima::fastdds::dds::SampleInfo& info) {
+        // Before the lock: Fast DDS may hand its own sample back on the writing thread, which
+        // holds mutex_ (share_calibration).
+        if (dds::writer_id(info.publication_handle) == own_calibration_writer_) return;
+        std::lock_guard<std::mutex> lock(mutex_);
+        std::size_t beacons = 0;
+        for (const msg::GroupCalibration& g : m.groups()) beacons += g.beacons().size();
+        if (m.groups().size() > kMaxBeacons || beacons > kMaxBeacons) {
+          ++calibrations_refused_too_large_;  // not even converted: no site has that many
+          return;
+        }
+        if (m.frame_id() != map_frame_id_) {
+          ++calibrations_refused_other_frame_;  // positions in a frame that is not the map's
+          return;
+        }
+        core_.on_calibration(dds::from_msg(m));
+        share_calibration();
+      }));
   // The beacon measurements, as the estimator hears them (beacon_input): the decoder's ranges,
   // the gateway's raw TOFs, or its pulse arrivals (seed 002); never two kinds. A robot whose measurements miss their deadline (two beacon slots) coasts on odometry,
   // degraded; a writer that dies or hangs (liveliness, lease 1 s) is reported, not only felt as
@@ -107,6 +163,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
     readers_.push_back(participant_.subscribe<msg::LaserScanPubSubType>(dds::kLaserScanTopic, [this](const msg::LaserScan& m) {
       std::lock_guard<std::mutex> lock(mutex_);
       if (auto corrected = core_.on_laser(m.robot_id(), dds::from_msg(m))) publish(*corrected);
+      share_calibration();
     }));
   }
   readers_.push_back(participant_.subscribe<msg::InitialPosePubSubType>(
@@ -168,6 +225,7 @@ void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
       }
     }
     if (auto out = core_.on_odometry(m.robot_id(), dds::from_msg(m))) publish(*out);
+    share_calibration();
     newest_odometry_stamp_ns_ = std::max(newest_odometry_stamp_ns_.load(), m.stamp_ns());
   }
   ++odometry_processed_;
@@ -198,6 +256,23 @@ void LocalizerParticipant::publish(const LocalizerOutput& out) {
       state.values().push_back(value);
     }
     state_writer_->write(&state);
+  }
+}
+
+void LocalizerParticipant::share_calibration() {
+  if (core_.calibration_revision() == calibration_shared_revision_) return;
+  calibration_shared_revision_ = core_.calibration_revision();
+  auto m = dds::to_msg(core_.calibration(), map_frame_id_);
+  calibration_writer_->write(&m);
+  if (options_.calibration_file.empty()) return;
+  // A few times per drive (each group calibrated once, again after the backwards drive): the
+  // write and its two flushes to the disk (milliseconds) hold this robot's samples that long.
+  const CalibrationFileResult saved = save_calibration(options_.calibration_file, core_.calibration());
+  if (saved.ok()) {
+    calibration_save_error_.clear();
+  } else {
+    ++calibration_saves_failed_;
+    calibration_save_error_ = std::string(to_string(saved.problem)) + ": " + saved.detail;
   }
 }
 
@@ -238,6 +313,15 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
     message += "; beacon map replaced " + std::to_string(core_.beacon_map_changes()) +
                " time(s), every robot restarted on it";
   }
+  if (!core_.calibration().groups.empty()) {
+    message += "; beacon calibration: " + std::to_string(core_.calibration().groups.size()) + " group(s)";
+  }
+  if (!calibration_save_error_.empty()) {
+    // The newest calibration would not survive a restart.
+    status = msg::PARTICIPANT_STATUS_DEGRADED;
+    message = "beacon calibration not saved to " + options_.calibration_file + " (" + calibration_save_error_ +
+              "); " + message;
+  }
   if (map_sources_.disagree()) {
     // Whichever map arrived last is in use; the robots flip between layouts as the maps arrive.
     status = msg::PARTICIPANT_STATUS_DEGRADED;
@@ -257,6 +341,9 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   counts.reject("odometry.lost_increment", lost_increments_);
   counts.reject("odometry.sequence_restart", sequence_restarts_);
   counts.reject("diagnostics.too_many_robots", peer_reports_refused_);
+  counts.reject("calibration_file.write_failed", calibration_saves_failed_);
+  counts.reject("calibration.too_many_beacons", calibrations_refused_too_large_);
+  counts.reject("calibration.other_frame", calibrations_refused_other_frame_);
   auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, deadline_misses_.load(),
                                  status, message);
   d.writers_lost(odometry_writers_lost_.load() + range_writers_lost_.load());

@@ -1,7 +1,9 @@
 #pragma once
 // localizer participant: Odometry + BeaconRange (+ BeaconMap) -> PoseEstimate, through the
 // LocalizerCore (one estimator plugin instance per robot); Diagnostics at 1 Hz, listing the robots
-// it serves. It reads the other participants' Diagnostics, not their poses: a robot another live
+// it serves. The site's beacon calibration (seed 003) goes both ways on BeaconCalibration: what
+// its robots calibrate is published and kept in the calibration file, what others calibrated is
+// used by its robots. It reads the other participants' Diagnostics, not their poses: a robot another live
 // localizer serves too is a conflict (ServingConflicts), its poses degraded while it lasts.
 #include <beaconloc.h>
 
@@ -9,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -20,9 +23,24 @@
 
 namespace beaconloc {
 
+struct LocalizerParticipantOptions {
+  // Where the site's beacon calibration is kept (calibration_store.hpp), so that it survives a
+  // restart of every participant: read at start (none there yet is no error; a file that cannot
+  // be read or fails its checks stops the start with the reason), written again whenever the
+  // calibration changes. Empty: the calibration lives on the bus alone.
+  std::string calibration_file;
+};
+
+// A calibration file that exists and cannot be used: the start is refused, with the reason.
+class CalibrationFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 class LocalizerParticipant {
  public:
-  LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core);
+  // Throws CalibrationFileError (see LocalizerParticipantOptions::calibration_file).
+  LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core, LocalizerParticipantOptions options = {});
   void publish_diagnostics() { diagnostics_->publish_now(); }
   // Samples taken from the bus, for a throttle in the same process.
   std::uint64_t odometry_processed() const { return odometry_processed_.load(); }
@@ -41,6 +59,9 @@ class LocalizerParticipant {
   void on_odometry(const msg::Odometry& odometry);
   void publish(const LocalizerOutput& out);  // under mutex_
   void on_peer_diagnostics(const msg::Diagnostics& d, const std::string& writer);
+  // The site's calibration, when it changed (a robot calibrated a group, another localizer's
+  // arrived): on the bus, and into the calibration file. Under mutex_.
+  void share_calibration();
   // Subscribes to the topic the robots' beacon measurements come on (beacon_range, or raw_tof),
   // with its deadline and liveliness events; fuse gives a sample to the core under mutex_.
   template <class PubSubType, class Fuse>
@@ -67,10 +88,19 @@ class LocalizerParticipant {
   std::atomic<std::uint64_t> ranges_processed_{0};
   std::atomic<std::uint64_t> poses_written_{0};
   std::atomic<StampNs> newest_odometry_stamp_ns_{0};
+  LocalizerParticipantOptions options_;
+  std::string map_frame_id_ = "map";               // the beacon map's, for the calibration's positions
+  std::uint64_t calibration_shared_revision_ = 0;  // core_.calibration_revision() last shared
+  std::string own_calibration_writer_;             // its own calibration comes back to its reader
+  std::uint64_t calibration_saves_failed_ = 0;
+  std::uint64_t calibrations_refused_too_large_ = 0;  // more groups or beacons than kMaxBeacons
+  std::uint64_t calibrations_refused_other_frame_ = 0;  // frame_id not the beacon map's
+  std::string calibration_save_error_;             // the last failure, while the newest is unsaved
   // The entities, owned: the readers, declared last, stop first, before what they use goes.
   dds::Participant participant_;
   dds::Writer pose_writer_;
   dds::Writer state_writer_;  // EstimatorState: what the estimator holds beside the pose
+  dds::Writer calibration_writer_;  // BeaconCalibration: the site's calibrated beacon groups
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
   std::vector<dds::Reader> readers_;
 };

@@ -18,6 +18,7 @@
 #include <random>
 #include <sstream>
 
+#include "beaconloc/core/beacon_map.hpp"
 #include "beaconloc/core/calibration_store.hpp"
 
 namespace beaconloc {
@@ -185,31 +186,125 @@ TEST(CalibrationStore, EveryDamagedFileIsRefusedByReason) {
   EXPECT_EQ(r.problem, CalibrationFileProblem::kTooLarge);
 }
 
+// What several sources found, gathered: a group's surer calibration replaces the one held (then
+// the later one, then by value); the groups sorted, so that the same knowledge compares equal
+// whatever order it came in.
+TEST(BeaconCalibration, MergedGroupByGroupTheSurerReplacingTheOther) {
+  BeaconCalibration site;
+  const BeaconCalibration first = calibration(5, 2, 3, 0.0);   // groups 5, 6
+  BeaconCalibration later = calibration(4, 2, 3, 1.0);         // groups 4, 5: 5 found again, later, as sure
+  EXPECT_TRUE(merge_calibration(site, first));
+  EXPECT_EQ(site, first);
+  EXPECT_FALSE(merge_calibration(site, first));  // nothing new
+  EXPECT_TRUE(merge_calibration(site, later));
+  ASSERT_EQ(site.groups.size(), 3u);
+  EXPECT_EQ(site.groups[0].group, 4u);
+  EXPECT_EQ(site.groups[1].group, 5u);
+  EXPECT_EQ(site.groups[2].group, 6u);
+  EXPECT_EQ(site.groups[1].transform, later.groups[1].transform);  // as sure, and later
+  EXPECT_EQ(site.groups[2].transform, first.groups[1].transform);
+  // Group 5 earlier but surer: it wins; a later, looser one does not.
+  GroupCalibration surer = first.groups[0];
+  surer.stamp_ns -= 1000;
+  for (auto& b : surer.beacons) b.covariance_m2 *= 0.5;
+  EXPECT_TRUE(merge_calibration(site, BeaconCalibration{{surer}}));
+  EXPECT_EQ(BeaconCalibration{{site.groups[1]}}, BeaconCalibration{{surer}});
+  EXPECT_FALSE(merge_calibration(site, later));
+  // Whatever order the versions come in, the same result.
+  const std::vector<BeaconCalibration> versions{first, later, BeaconCalibration{{surer}}};
+  for (const auto& order : std::vector<std::vector<int>>{{0, 1, 2}, {2, 1, 0}, {1, 2, 0}, {2, 0, 1}}) {
+    BeaconCalibration other;
+    for (int k : order) merge_calibration(other, versions[static_cast<std::size_t>(k)]);
+    EXPECT_EQ(other, site);
+  }
+}
+
+// Only the groups the map holds as locally referenced, with exactly its beacons, each where the
+// group's transform puts the map's beacon (eq. 41-43), are used.
+TEST(BeaconCalibration, OnlyTheGroupsThatFitTheMapAreUsed) {
+  BeaconList beacons;
+  beacons.map_frame.push_back({1, Eigen::Vector3d(0.0, 0.0, 3.0), 1});  // group 1: globally referenced
+  beacons.map_frame.push_back({2, Eigen::Vector3d(1.0, 0.0, 3.0), 1});
+  beacons.map_frame.push_back({3, Eigen::Vector3d(0.0, 1.0, 3.0), 1});
+  for (std::uint32_t id = 10; id < 13; ++id) beacons.group_frame.push_back({id, 2, Eigen::Vector3d(id, 0.5, 3.0)});
+  for (std::uint32_t id = 20; id < 23; ++id) beacons.group_frame.push_back({id, 3, Eigen::Vector3d(id, -0.5, 3.0)});
+  const BeaconMap map(beacons);
+  // Each group of the calibration placed by its transform from the map's group frame.
+  const auto placed = [&](std::uint32_t group, std::vector<std::uint32_t> ids) {
+    GroupCalibration g;
+    g.group = group;
+    g.transform << 0.6, 0.8, 10.0, -3.0;
+    for (std::uint32_t id : ids) {
+      CalibratedBeacon b;
+      b.id = id;
+      const LocalBeacon* local = map.find_local(id);
+      const Eigen::Vector3d p = local ? local->position_group_m : Eigen::Vector3d(1.0, 2.0, 3.0);
+      b.position_map_m << 0.6 * p.x() - 0.8 * p.y() + 10.0, 0.8 * p.x() + 0.6 * p.y() - 3.0, p.z();
+      g.beacons.push_back(b);
+    }
+    return g;
+  };
+  BeaconCalibration c;
+  c.groups.push_back(placed(1, {1, 2, 3}));     // a GRULPS
+  c.groups.push_back(placed(2, {10, 11}));      // short of the map's beacon 12
+  c.groups.push_back(placed(3, {20, 21, 22}));  // fits
+  c.groups.push_back(placed(4, {30, 31, 32}));  // no such group
+  GroupCalibration moved = placed(2, {10, 11, 12});
+  moved.group = 2;
+  moved.beacons[2].position_map_m.y() += 0.002;  // 2 mm off its transform: the frame re-surveyed
+  c.groups.push_back(moved);
+  std::vector<std::uint32_t> unfit;
+  const BeaconCalibration fitting = calibration_fitting(c, map, &unfit);
+  ASSERT_EQ(fitting.groups.size(), 1u);
+  EXPECT_EQ(fitting.groups[0].group, 3u);
+  EXPECT_EQ(unfit, (std::vector<std::uint32_t>{1, 2, 4, 2}));
+  EXPECT_EQ(calibration_fitting(BeaconCalibration{{placed(2, {10, 11, 12})}}, map).groups.size(), 1u);
+}
+
 // A child saves two calibrations in turn as fast as it can; it is killed (SIGKILL: no handler, no
-// flush) at a random instant, 60 times. Each time the file holds one of the two, whole.
+// flush) at a random instant, at least 60 times and until 5 kills have landed inside a save
+// (between the temporary's open and its rename; fewer land there on a loaded machine, where a
+// forked child takes longer to start saving). Each time the file holds one of the two, whole.
 TEST(CalibrationStore, AWriterKilledWhileItWritesLeavesTheOldCalibrationOrTheNew) {
   const std::string path = temporary_path("killed.calibration");
   const BeaconCalibration a = calibration(3, 10, 20, 0.0);  // 200 beacons: ~15 kB a write
   const BeaconCalibration b = calibration(3, 10, 20, 1.0);
-  // The kills land anywhere in the child's first few saves, however fast this build saves.
-  const auto began = std::chrono::steady_clock::now();
   ASSERT_TRUE(save_calibration(path, a).ok());
-  const auto save_us =
-      std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - began).count();
   std::mt19937_64 rng(5);
-  std::uniform_int_distribution<long> delay_us(0, 3 * std::max<long>(static_cast<long>(save_us), 1000));
+  std::uniform_real_distribution<double> fraction(0.0, 2.0);
   int saw_a = 0, saw_b = 0;
   int inside_save = 0;       // kills between the temporary's open and its rename
   int torn_temporaries = 0;  // of those, while the temporary was half written
-  for (int round = 0; round < 60; ++round) {
+  constexpr int kMinRounds = 60, kMaxRounds = 600, kInsideSaveWanted = 5;
+  int rounds = 0;
+  long save_us = 0;  // one save of the child's, as the parent saw it (the newest round's)
+  for (int round = 0; round < kMaxRounds && (round < kMinRounds || inside_save < kInsideSaveWanted); ++round) {
+    ++rounds;
+    // The child says each save it finished. After its first two (however slow a forked,
+    // instrumented or loaded child starts), the kill lands within the next two saves' time: the
+    // child is saving all along.
+    int saved[2];
+    ASSERT_EQ(::pipe(saved), 0);
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
+      ::close(saved[0]);
       for (int i = 0;; ++i) {
         if (!save_calibration(path, i % 2 == 0 ? b : a).ok()) ::_exit(3);
+        const char done = 1;
+        if (i < 2 && ::write(saved[1], &done, 1) != 1) ::_exit(4);
       }
     }
-    ::usleep(static_cast<useconds_t>(delay_us(rng)));
+    ::close(saved[1]);
+    char done = 0;
+    ASSERT_EQ(::read(saved[0], &done, 1), 1);
+    const auto first = std::chrono::steady_clock::now();
+    ASSERT_EQ(::read(saved[0], &done, 1), 1);
+    save_us = std::max<long>(
+        1, static_cast<long>(
+               std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - first).count()));
+    ::close(saved[0]);
+    ::usleep(static_cast<useconds_t>(fraction(rng) * static_cast<double>(save_us)));
     ASSERT_EQ(::kill(child, SIGKILL), 0);
     int status = 0;
     ASSERT_EQ(::waitpid(child, &status, 0), child);
@@ -230,14 +325,15 @@ TEST(CalibrationStore, AWriterKilledWhileItWritesLeavesTheOldCalibrationOrTheNew
       FAIL() << "round " << round << ": a calibration that was never written";
     }
   }
-  std::printf("killed 60 writers: the file held the first calibration %d times, the second %d times; %d killed "
+  std::printf("one save of the child %ld us; killed %d writers: the file held the first calibration %d times, the second %d times; %d killed "
               "between the temporary's open and its rename, %d of them with the temporary half written\n",
-              saw_a, saw_b, inside_save, torn_temporaries);
-  EXPECT_GT(inside_save, 0);
+              static_cast<long>(save_us), rounds, saw_a, saw_b, inside_save, torn_temporaries);
+  EXPECT_GE(inside_save, kInsideSaveWanted);
   // The test can tell: a writer that overwrites the file in place, killed the same way, leaves
   // torn files.
-  int torn = 0;
-  for (int round = 0; round < 30; ++round) {
+  int torn = 0, in_place_rounds = 0;
+  for (int round = 0; round < 10 * kMinRounds && (round < kMinRounds / 2 || torn == 0); ++round) {
+    ++in_place_rounds;
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0) {
@@ -246,14 +342,14 @@ TEST(CalibrationStore, AWriterKilledWhileItWritesLeavesTheOldCalibrationOrTheNew
         in_place << format_calibration(i % 2 == 0 ? b : a);
       }
     }
-    ::usleep(static_cast<useconds_t>(delay_us(rng)));
+    ::usleep(static_cast<useconds_t>(fraction(rng) * static_cast<double>(save_us)));
     ASSERT_EQ(::kill(child, SIGKILL), 0);
     int status = 0;
     ASSERT_EQ(::waitpid(child, &status, 0), child);
     CalibrationFileResult r;
     if (!load_calibration(path, &r)) ++torn;
   }
-  std::printf("killed 30 writers that overwrite in place: %d torn files\n", torn);
+  std::printf("killed %d writers that overwrite in place: %d torn files\n", in_place_rounds, torn);
   EXPECT_GT(torn, 0);
   // A save after them all.
   ASSERT_TRUE(save_calibration(path, b).ok());

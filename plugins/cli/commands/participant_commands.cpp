@@ -87,7 +87,8 @@ class LocalizerCommand : public Command {
       }
       return 0;
     }
-    LocalizerParticipant participant(dds_, LocalizerCore(settings_.estimator, settings_.config(), settings_.robot));
+    LocalizerParticipant participant(dds_, LocalizerCore(settings_.estimator, settings_.config(), settings_.robot),
+                                     {settings_.calibration_file});
     run_until_stopped();
     return 0;
   }

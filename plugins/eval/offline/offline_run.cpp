@@ -23,7 +23,8 @@ EstimatorConfig config_for(const sim::Scenario& scenario, const std::map<std::st
   return config;
 }
 
-// The scenario's range limits and noise (what `beaconloc run --scenario` gives its decoder).
+}  // namespace
+
 TofDecoderConfig decoder_config_for(const sim::Scenario& scenario) {
   TofDecoderConfig c;
   c.min_range_m = scenario.min_range_m;
@@ -32,7 +33,11 @@ TofDecoderConfig decoder_config_for(const sim::Scenario& scenario) {
   return c;
 }
 
-}  // namespace
+TofDecoder scenario_decoder(const sim::Scenario& scenario) {
+  TofDecoder decoder(decoder_config_for(scenario));
+  decoder.set_beacon_map(BeaconMap(scenario.beacon_list()));
+  return decoder;
+}
 
 std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed, double duration_s) {
   sim::SimSource source(scenario, seed);

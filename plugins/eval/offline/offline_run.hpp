@@ -16,6 +16,11 @@
 
 namespace beaconloc {
 
+// The decoder `beaconloc run --scenario` gives the scenario: its range limits and noise, its
+// beacon map as the gateway publishes it (locally referenced groups in their own frames).
+TofDecoderConfig decoder_config_for(const sim::Scenario& scenario);
+TofDecoder scenario_decoder(const sim::Scenario& scenario);
+
 // Every event of a scenario up to duration_s, in stamp order.
 std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t seed, double duration_s);
 

@@ -4,6 +4,7 @@
 #include <iterator>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace beaconloc {
 
@@ -26,6 +27,25 @@ void OutOfSequenceFusion::set_beacon_map(const BeaconMap& map) {
   }
 }
 
+bool OutOfSequenceFusion::use_calibration(const BeaconCalibration& calibration) {
+  const bool taken = estimator_->use_calibration(calibration);
+  if (!taken) return false;
+  // The copies hold it as given, not as news: a replay from one does not report it again.
+  base_->use_calibration(calibration);
+  base_->take_calibration_update();
+  for (auto& e : history_) {
+    if (!e.checkpoint) continue;
+    e.checkpoint->use_calibration(calibration);
+    e.checkpoint->take_calibration_update();
+  }
+  collect_outputs();
+  return true;
+}
+
+std::optional<BeaconCalibration> OutOfSequenceFusion::take_calibration_update() {
+  return std::exchange(calibration_update_, std::nullopt);
+}
+
 InputResult OutOfSequenceFusion::apply(const Event& e) {
   const InputResult result = estimator_->push(e.input);
   collect_outputs();  // before any checkpoint: a copy must not carry reports already passed on
@@ -35,6 +55,7 @@ InputResult OutOfSequenceFusion::apply(const Event& e) {
 void OutOfSequenceFusion::collect_outputs() {
   for (auto& a : estimator_->take_associations()) associations_.push_back(a);
   for (auto& r : estimator_->take_deferred_rejections()) deferred_rejections_.push_back(std::move(r));
+  if (auto c = estimator_->take_calibration_update()) calibration_update_ = std::move(c);
 }
 
 InputResult OutOfSequenceFusion::push(EstimatorInput input) {

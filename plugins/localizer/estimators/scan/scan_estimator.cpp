@@ -75,6 +75,7 @@ void ScanEstimator::set_beacon_map(const BeaconMap& map) {
   for (const LocalBeacon& b : map.local_beacons()) local_.try_emplace(b.group, params_);
   calibrated_.clear();
   calibration_ = {};
+  calibration_changed_ = false;  // nothing the site learnt is withdrawn: the map's change is the localizer's to handle
   open_epochs_.clear();
   last_range_.clear();
   log_.clear();
@@ -86,21 +87,21 @@ void ScanEstimator::set_beacon_map(const BeaconMap& map) {
 }
 
 bool ScanEstimator::use_calibration(const BeaconCalibration& c) {
-  if (!check_calibration(c).ok()) return false;
-  std::map<std::uint32_t, std::set<std::uint32_t>> group_beacons;  // the map's locally referenced groups
-  for (const LocalBeacon& b : map().local_beacons()) group_beacons[b.group].insert(b.id);
+  if (!check_calibration(c).ok() || calibration_fitting(c, map()).groups.size() != c.groups.size()) return false;
   for (const GroupCalibration& g : c.groups) {
-    const auto in_map = group_beacons.find(g.group);
-    if (in_map == group_beacons.end() || in_map->second.size() != g.beacons.size()) return false;
-    for (const CalibratedBeacon& b : g.beacons) {
-      if (in_map->second.count(b.id) == 0) return false;
-    }
-  }
-  for (const GroupCalibration& g : c.groups) {
+    const auto held = std::find_if(calibration_.groups.begin(), calibration_.groups.end(),
+                                   [&](const GroupCalibration& h) { return h.group == g.group; });
+    if (held != calibration_.groups.end() && BeaconCalibration{{*held}} == BeaconCalibration{{g}}) continue;
     local_.erase(g.group);
     calibrate(g.group, g);
   }
   return true;
+}
+
+std::optional<BeaconCalibration> ScanEstimator::take_calibration_update() {
+  if (!calibration_changed_) return std::nullopt;
+  calibration_changed_ = false;
+  return calibration_;
 }
 
 bool ScanEstimator::pairs_possible(StampNs now_ns) const {
@@ -470,6 +471,7 @@ void ScanEstimator::finish_overlaps(StampNs now_ns) {
 // A group's calibration in, or in place of the one it had.
 void ScanEstimator::calibrate(std::uint32_t group, const GroupCalibration& g) {
   for (const CalibratedBeacon& b : g.beacons) calibrated_[b.id] = b;
+  calibration_changed_ = true;
   for (GroupCalibration& old : calibration_.groups) {
     if (old.group == group) {
       old = g;

@@ -14,9 +14,10 @@
 // fixes of its group (group_fix.hpp, frame_start.hpp).
 //
 // Deviations and choices (the paper is silent):
-//  - the overlap ends when the global filter has had no correction for overlap_end_s while the
-//    group's own filter still has: the calibration is then final (Sec. 3.5.1: "when the MR is in
-//    the last position of the common coverage area"). A group calibrated once stays so.
+//  - the overlap ends when the global filter has had no correction for overlap_end_s (the robot
+//    has left the known groups' coverage; the group's own filter is not asked): the calibration
+//    is then final (Sec. 3.5.1: "when the MR is in the last position of the common coverage
+//    area"). A group calibrated once stays so.
 //  - a calibrated beacon's covariance is the global track's position covariance averaged over
 //    the pairs plus the transform's misfit (eq. 46's mean error, half of its square per axis);
 //    the global filter adds it to the range's variance along the line of sight.
@@ -98,7 +99,10 @@ class ScanEstimator final : public EstimatorBase {
   // Refused whole (false) when check_calibration refuses it or it does not fit the map: a group
   // the map does not hold as locally referenced, or a group's beacons not exactly the map's.
   // Given after the map (a new map drops it with everything else).
-  bool use_calibration(const BeaconCalibration& calibration);
+  // A group held with that very calibration already is left as it is.
+  bool uses_calibration() const override { return true; }
+  bool use_calibration(const BeaconCalibration& calibration) override;
+  std::optional<BeaconCalibration> take_calibration_update() override;
   // Groups whose overlap is under way: the transform so far (nullopt before one exists).
   std::optional<GroupCalibration> provisional_calibration(std::uint32_t group) const;
 
@@ -190,6 +194,7 @@ class ScanEstimator final : public EstimatorBase {
   std::map<std::uint32_t, LocalGroup> local_;           // by group, the LRULPSs not calibrated yet
   std::map<std::uint32_t, CalibratedBeacon> calibrated_;  // by beacon id
   BeaconCalibration calibration_;
+  bool calibration_changed_ = false;  // since take_calibration_update last asked
   std::map<std::uint32_t, Epoch> open_epochs_;  // by group
   std::map<std::uint32_t, std::pair<StampNs, double>> last_range_;  // by beacon: its previous range's stamp, range
   // Sec. 3.6: the inputs since the robot last left a GRULPS, and when it came back to one.

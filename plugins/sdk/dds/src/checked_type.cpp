@@ -104,6 +104,8 @@ bool well_formed(const msg::BeaconMap& m) {
          std::all_of(m.beacons().begin(), m.beacons().end(), [](const msg::Beacon& b) { return defined(b.frame()); });
 }
 
+bool well_formed(const msg::BeaconCalibration& m) { return printable(m.frame_id()); }
+
 bool well_formed(const msg::Diagnostics& m) {
   if (!identifier(m.participant()) || !printable(m.message()) || !defined(m.status())) return false;
   for (const auto& r : m.rejected()) {

@@ -170,6 +170,54 @@ msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id) {
   return m;
 }
 
+BeaconCalibration from_msg(const msg::BeaconCalibration& m) {
+  BeaconCalibration c;
+  for (const msg::GroupCalibration& mg : m.groups()) {
+    GroupCalibration g;
+    g.group = mg.group();
+    g.stamp_ns = mg.stamp_ns();
+    g.transform = Eigen::Vector4d(mg.a(), mg.b(), mg.tx_m(), mg.ty_m());
+    g.mean_error_m = mg.mean_error_m();
+    for (const msg::CalibratedBeacon& mb : mg.beacons()) {
+      CalibratedBeacon b;
+      b.id = mb.id();
+      b.position_map_m = Eigen::Vector3d(mb.x_m(), mb.y_m(), mb.z_m());
+      b.covariance_m2 = Eigen::Map<const Eigen::Matrix<double, 2, 2, Eigen::RowMajor>>(mb.covariance_m2().data());
+      g.beacons.push_back(b);
+    }
+    c.groups.push_back(std::move(g));
+  }
+  return c;
+}
+
+msg::BeaconCalibration to_msg(const BeaconCalibration& c, const std::string& frame_id) {
+  msg::BeaconCalibration m;
+  m.frame_id(frame_id);
+  for (const GroupCalibration& g : c.groups) {
+    msg::GroupCalibration mg;
+    mg.group(g.group);
+    mg.stamp_ns(g.stamp_ns);
+    mg.a(g.transform(0));
+    mg.b(g.transform(1));
+    mg.tx_m(g.transform(2));
+    mg.ty_m(g.transform(3));
+    mg.mean_error_m(g.mean_error_m);
+    for (const CalibratedBeacon& b : g.beacons) {
+      msg::CalibratedBeacon mb;
+      mb.id(b.id);
+      mb.x_m(b.position_map_m.x());
+      mb.y_m(b.position_map_m.y());
+      mb.z_m(b.position_map_m.z());
+      std::array<double, 4> covariance{};
+      Eigen::Map<Eigen::Matrix<double, 2, 2, Eigen::RowMajor>>(covariance.data()) = b.covariance_m2;
+      mb.covariance_m2(covariance);
+      mg.beacons().push_back(mb);
+    }
+    m.groups().push_back(std::move(mg));
+  }
+  return m;
+}
+
 msg::PoseEstimate to_msg(const std::string& robot_id, const PoseEstimate& e, const std::string& estimator,
                          const std::vector<std::uint32_t>& beacons_used) {
   msg::PoseEstimate m;

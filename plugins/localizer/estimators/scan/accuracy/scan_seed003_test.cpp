@@ -19,7 +19,10 @@
 namespace beaconloc::scan {
 namespace {
 
+// The seed 003 scenario, or BEACONLOC_SEED003_SCENARIO's (a copy with one assumption changed, to
+// see what the figures depend on: docs/accuracy-seed003.md).
 sim::Scenario seed003() {
+  if (const char* file = std::getenv("BEACONLOC_SEED003_SCENARIO")) return sim::load_scenario_file(file);
   return sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/seed003_scan.yaml");
 }
 
@@ -39,12 +42,7 @@ ScanRun run(const sim::Scenario& s, std::uint64_t seed, const std::map<std::stri
   ScanEstimator scan(config);
   const BeaconMap map(s.beacon_list());
   scan.set_beacon_map(map);
-  TofDecoderConfig dc;
-  dc.min_range_m = s.min_range_m;
-  dc.max_range_m = s.max_range_m;
-  dc.range_sigma_m = s.range_sigma_m;
-  TofDecoder decoder(dc);
-  decoder.set_beacon_map(map);
+  TofDecoder decoder = scenario_decoder(s);
   ScanRun out;
   double sum2 = 0.0;
   double next_print_s = 0.0;

@@ -29,12 +29,7 @@ EstimatorConfig config_of(const sim::Scenario& s, std::map<std::string, double> 
 
 // The simulated inputs as the localizer would push them (the decoder's ranges).
 std::vector<EstimatorInput> inputs(const sim::Scenario& s, double until_s) {
-  TofDecoderConfig dc;
-  dc.min_range_m = s.min_range_m;
-  dc.max_range_m = s.max_range_m;
-  dc.range_sigma_m = s.range_sigma_m;
-  TofDecoder decoder(dc);
-  decoder.set_beacon_map(BeaconMap(s.beacon_list()));
+  TofDecoder decoder = scenario_decoder(s);
   std::vector<EstimatorInput> out;
   for (const SourceEvent& e : simulate(s, 1, until_s)) {
     if (auto in = estimator_input("robot", e, decoder, BeaconInput::kRanges)) out.push_back(*in);
@@ -180,11 +175,7 @@ TEST(ScanEstimator, AFrameTheGrulpsContradictsIsFoundAgainAndDegradedMeanwhile) 
   sim::SimSource source(s, 1);
   std::vector<SourceEvent> events;
   source.advance(s_to_ns(14.0), events);
-  TofDecoderConfig dc;
-  dc.max_range_m = s.max_range_m;
-  dc.range_sigma_m = s.range_sigma_m;
-  TofDecoder decoder(dc);
-  decoder.set_beacon_map(BeaconMap(s.beacon_list()));
+  TofDecoder decoder = scenario_decoder(s);
   bool degraded = false;
   double worst_ok_error_m = 0.0;
   for (const SourceEvent& e : events) {
@@ -292,11 +283,7 @@ TEST(ScanEstimator, ASecondRobotGivenTheCalibrationLocalizesInTheCalibratedGroup
   ScanEstimator second(config_of(s));
   second.set_beacon_map(map);
   ASSERT_TRUE(second.use_calibration(calibration));
-  TofDecoderConfig dc;
-  dc.max_range_m = s.max_range_m;
-  dc.range_sigma_m = s.range_sigma_m;
-  TofDecoder decoder(dc);
-  decoder.set_beacon_map(map);
+  TofDecoder decoder = scenario_decoder(s);
   double sum2 = 0.0;
   std::size_t scored = 0, ok = 0;
   for (const SourceEvent& e : simulate(s, 2, s.duration_s)) {

@@ -14,6 +14,8 @@
 
 namespace beaconloc {
 
+class BeaconMap;
+
 struct CalibratedBeacon {
   std::uint32_t id = 0;
   Eigen::Vector3d position_map_m = Eigen::Vector3d::Zero();  // z as the group frame gives it
@@ -57,5 +59,23 @@ struct CalibrationCheck {
   std::string describe() const;  // "group 4: bad_covariance"
 };
 CalibrationCheck check_calibration(const BeaconCalibration& calibration);
+
+// What a site knows is gathered from several sources (robots calibrating, the bus, a file): a
+// group in `update` the site does not hold is added; one it holds is replaced when the update's
+// is better (its beacons surer: the smaller sum of their covariances' traces; then the later
+// stamp; then by value: a total order, so that every localizer keeps the same calibration of a
+// group whatever order the versions came in). The groups stay sorted by id, so that equal
+// knowledge compares equal. Returns whether `site` changed. Both are checked calibrations; the
+// result is one too unless two groups name one beacon (checked by the caller).
+bool merge_calibration(BeaconCalibration& site, const BeaconCalibration& update);
+
+// The groups of a calibration that fit the map: each a group the map holds as locally
+// referenced, with exactly the map's beacons of that group, each where the group's transform
+// (eq. 41) puts the map's beacon (to 1 mm; z the group frame's). A group that does not fit (its
+// group unknown or globally referenced, its beacons not the map's, or moved in their group's
+// frame since: another site's, or a map changed since) goes to *unfit, when given: it is never
+// used, as its beacons are not the map's beacons.
+BeaconCalibration calibration_fitting(const BeaconCalibration& calibration, const BeaconMap& map,
+                                      std::vector<std::uint32_t>* unfit = nullptr);
 
 }  // namespace beaconloc

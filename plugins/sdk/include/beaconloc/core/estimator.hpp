@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "beaconloc/core/beacon_calibration.hpp"
 #include "beaconloc/core/beacon_map.hpp"
 #include "beaconloc/core/estimator_input.hpp"
 #include "beaconloc/core/measurements.hpp"
@@ -146,6 +147,15 @@ class Estimator {
   // Measurements held for a later step whose fusion then failed (the step itself succeeded),
   // as rejection reasons since last asked: the localizer counts them.
   virtual std::vector<Rejection> take_deferred_rejections() { return {}; }
+  // What the site learns from a robot (seed 003: locally referenced beacon groups calibrated
+  // while it drives), shared with every robot: the estimator's whole calibration when it changed
+  // since last asked; nullopt otherwise, and always for estimators that calibrate nothing.
+  virtual std::optional<BeaconCalibration> take_calibration_update() { return std::nullopt; }
+  // A calibration found before (another robot, a restart: the BeaconCalibration topic, a file),
+  // given after the map: its groups are used at once, with no calibration drive. False when the
+  // estimator refuses it (it does not fit the map) or uses no calibration.
+  virtual bool uses_calibration() const { return false; }
+  virtual bool use_calibration(const BeaconCalibration& /*calibration*/) { return false; }
   // Restart from this pose (an operator's or rviz2's initial pose), stamped stamp_ns; the
   // estimators that cannot be placed refuse with a reason.
   virtual InputResult reset(StampNs /*stamp_ns*/, const Pose2& /*pose_map_base*/,

@@ -56,6 +56,13 @@ class OutOfSequenceFusion {
   InputResult reset(StampNs stamp_ns, const Pose2& pose_map_base, const Cov3& covariance);
 
   const Estimator& estimator() const { return *estimator_; }
+  // A calibration found before (Estimator::use_calibration), given to the estimator and to every
+  // copy a replay may start from, so that a late measurement does not roll it back. Whether the
+  // estimator took it.
+  bool use_calibration(const BeaconCalibration& calibration);
+  // The estimator's newest calibration when it changed since last asked (a replay that finds a
+  // calibration of its own again reports it again; one given by use_calibration is not news).
+  std::optional<BeaconCalibration> take_calibration_update();
   std::vector<Estimator::Association> take_associations();
   std::vector<Rejection> take_deferred_rejections();
 
@@ -90,6 +97,7 @@ class OutOfSequenceFusion {
   int odometry_since_checkpoint_ = 0;
   std::vector<Estimator::Association> associations_;
   std::vector<Rejection> deferred_rejections_;
+  std::optional<BeaconCalibration> calibration_update_;
   std::uint64_t replays_ = 0;
   std::uint64_t replayed_odometry_steps_ = 0;
 };

@@ -39,6 +39,7 @@ bool well_formed(const msg::PoseEstimate& m);
 bool well_formed(const msg::EstimatorState& m);
 bool well_formed(const msg::InitialPose& m);
 bool well_formed(const msg::BeaconMap& m);
+bool well_formed(const msg::BeaconCalibration& m);
 bool well_formed(const msg::Diagnostics& m);
 template <class Msg>
 bool well_formed(const Msg&) {

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "beaconloc/core/beacon_calibration.hpp"
 #include "beaconloc/core/beacon_map.hpp"
 #include "beaconloc/core/estimator.hpp"
 #include "beaconloc/core/measurements.hpp"
@@ -31,6 +32,11 @@ msg::LaserScan to_msg(const std::string& robot_id, const LaserScanSample& s);
 // frame the IDL does not define never gets here: checked_type.hpp refuses the sample.)
 BeaconList from_msg(const msg::BeaconMap& m);
 msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id);
+
+// A BeaconCalibration sample as sent, unchecked: the core checks it (check_calibration) and
+// counts a refused one as calibration.<reason>.
+BeaconCalibration from_msg(const msg::BeaconCalibration& m);
+msg::BeaconCalibration to_msg(const BeaconCalibration& calibration, const std::string& frame_id);
 
 msg::PoseEstimate to_msg(const std::string& robot_id, const PoseEstimate& estimate,
                          const std::string& estimator, const std::vector<std::uint32_t>& beacons_used);

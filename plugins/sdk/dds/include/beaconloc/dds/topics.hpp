@@ -22,6 +22,8 @@ inline constexpr TopicSpec kEstimatorStateTopic{"beaconloc/estimator_state", "es
 inline constexpr TopicSpec kInitialPoseTopic{"beaconloc/initial_pose", "initial_pose.writer",
                                              "initial_pose.reader"};
 inline constexpr TopicSpec kBeaconMapTopic{"beaconloc/beacon_map", "beacon_map.writer", "beacon_map.reader"};
+inline constexpr TopicSpec kBeaconCalibrationTopic{"beaconloc/beacon_calibration", "beacon_calibration.writer",
+                                                   "beacon_calibration.reader"};
 inline constexpr TopicSpec kDiagnosticsTopic{"beaconloc/diagnostics", "diagnostics.writer",
                                              "diagnostics.reader"};
 
