@@ -56,6 +56,9 @@ struct Scenario {
   // The beacon map the gateway publishes (and the offline runs hand over): the globally
   // referenced beacons at their map positions, the locally referenced ones in their group's frame.
   BeaconList beacon_list() const;
+  // Whether the group whose centre (the mean of its beacons' floor positions) is nearest
+  // p_map_m is locally referenced: where a robot localizes against calibrated beacons.
+  bool nearest_group_is_local(double x_map_m, double y_map_m) const;
   // Beacon system.
   std::vector<std::uint32_t> firing_order;           // beacon ids, one per slot, cycled
   StampNs slot_period_ns = 200 * kNsPerMillisecond;  // 5 Hz firing slots

@@ -68,10 +68,10 @@ struct ScanParameters {
   // needs the GRULPS's fixes at its start (5 s, on seed 003 at the coverage's edge, was too
   // short on one seed in four: the backwards global frame started as it left the GRULPS).
   double inverse_after_s = 10.0;
-  // The inputs kept for it (13 min of 100 Hz odometry and the ranges between: 8.6 MB); a longer
-  // leg between two GRULPSs has no backwards drive (inverse_passes_skipped counts it). The drive
-  // runs inside the odometry step that starts it: 4-40 ms for seed 003's 16 000 inputs (EKF to
-  // UKF), so up to 0.3 s at the cap (BENCHMARKS.md).
+  // The inputs kept for it (8.6 MB; 18 min of seed 003's drive, 100 Hz odometry and 12 ranges a
+  // second); a longer leg between two GRULPSs has no backwards drive (inverse_passes_skipped
+  // counts it). The drive runs inside the odometry step that starts it: 2.4 ms (EKF) for seed
+  // 003's 11 000 inputs, about 26 ms at the cap (BENCHMARKS.md).
   std::size_t max_recorded_inputs = 120000;
 
   static ScanParameters from(const EstimatorConfig& config);

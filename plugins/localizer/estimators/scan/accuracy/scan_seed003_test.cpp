@@ -86,6 +86,7 @@ ScanRun run(const sim::Scenario& s, std::uint64_t seed, const std::map<std::stri
 
 // Runs per configuration: 4 in the suite (1 s); the paper's 100 with BEACONLOC_SEED003_RUNS=100
 // (docs/accuracy-seed003.md).
+constexpr int kPaperRuns = 100;  // seed 003 Figs. 13 and 15: "average errors after 100 iterations"
 int runs() {
   const char* text = std::getenv("BEACONLOC_SEED003_RUNS");
   if (!text) return 4;
@@ -107,13 +108,16 @@ double mean_of(const std::vector<double>& v) {
 // H-infinity side by side on the same runs (the same seeds), spherical and hyperbolic, with the
 // analytic transform (d_min = 2.5 m) and the numerical one (Sec. 4.2: 20 points), and the
 // inverse trajectory. Every LRULPS is calibrated on
-// every run, in the order the robot meets them; the first (beside GRULPS 1) to under 0.1 m on
-// average (100 runs: 0.066-0.067 m spherical, 0.080-0.081 m hyperbolic, analytic); the
-// worst is one of the two in the middle of the chain (LRULPS #4 or #5: groups 6 and 7), farthest
-// from both GRULPSs, as the paper finds (Sec. 2: "LRULPS #4", Sec. 4.1: "LRULPS 5 ... around the
-// middle of the trajectory"). The paper's means are < 0.2 m spherical and < 0.4 m hyperbolic:
-// hyperbolic is met (100 runs: 0.349-0.356 m), spherical is NOT (0.285-0.299 m; its bound below
-// is a regression guard): docs/accuracy-seed003.md has the table and what stands in the way.
+// every run, in the order the robot meets them; the first and the last (beside a GRULPS, the
+// last calibrated again on the inverse trajectory) to under 0.1 m on average (100 runs:
+// 0.017-0.056 m and 0.020-0.046 m); the worst is one of the three in the middle of the chain
+// (LRULPS #3-#5: groups 5-7, 12-16 m from both GRULPSs, the others 4-8 m), as the paper finds
+// (Sec. 2: "LRULPS #4", Sec. 4.1: "LRULPS 5 ... around the middle of the trajectory"); which of
+// the three changes with the runs and the measurements. Over the paper's 100 runs the
+// analytic transform's means meet the paper's < 0.2 m spherical and < 0.4 m hyperbolic (100
+// runs: 0.150-0.159 m and 0.142-0.146 m); the numerical transform is held to 0.25 m (0.204-0.208
+// m spherical, 0.185-0.186 m hyperbolic). Over the suite's 4 runs the bounds are regression
+// guards (4 runs: 0.186-0.190 m, 0.154-0.155 m, 0.241-0.256 m). docs/accuracy-seed003.md.
 TEST(ScanOnSeed003, EveryGroupIsCalibratedAndTheWorstIsInTheMiddle) {
   const sim::Scenario s = seed003();
   const int n = runs();
@@ -134,35 +138,42 @@ TEST(ScanOnSeed003, EveryGroupIsCalibratedAndTheWorstIsInTheMiddle) {
       }
       std::uint32_t worst = 0;
       double worst_mean = -1.0;
-      std::printf("%s %s %s, %d runs: mean beacon error %.3f m; by group (mean):",
+      std::printf("%s %s %s, %d runs: mean beacon error %.3f m; by group (mean/median):",
                   numerical > 0 ? "numerical" : "analytic", hyperbolic > 0 ? "hyperbolic" : "spherical",
                   to_string(static_cast<FilterKind>(static_cast<int>(filter))), n, mean_of(all));
       for (const auto& [g, errors] : by_group) {
-        std::printf(" %u: %.3f", g, mean_of(errors));
+        std::vector<double> sorted = errors;
+        std::sort(sorted.begin(), sorted.end());
+        std::printf(" %u: %.3f/%.3f", g, mean_of(errors), sorted[sorted.size() / 2]);
         if (mean_of(errors) > worst_mean) {
           worst_mean = mean_of(errors);
           worst = g;
         }
       }
       std::printf("; worst %u\n", worst);
-      EXPECT_TRUE(worst == 6 || worst == 7) << worst;
+      EXPECT_TRUE(worst >= 5 && worst <= 7) << worst;
       EXPECT_LT(mean_of(by_group[3]), 0.10);
-      // The paper's 0.4 m hyperbolic (analytic); the others regression guards (see above).
-      EXPECT_LT(mean_of(all), hyperbolic > 0 ? (numerical > 0 ? 0.50 : 0.40) : 0.35);
+      EXPECT_LT(mean_of(by_group[9]), 0.10);
+      const double bound_m = n >= kPaperRuns ? (numerical > 0 ? 0.25 : hyperbolic > 0 ? 0.40 : 0.20)
+                                             : (numerical > 0 ? 0.35 : hyperbolic > 0 ? 0.40 : 0.30);
+      EXPECT_LT(mean_of(all), bound_m);
     }
   }
   }
 }
 
 // Fig. 11: the CDF of every calibrated beacon's error for several d_min (analytic method,
-// spherical, EKF). A d_min the overlap between two groups cannot hold (5 m on this building:
-// the robot hears two groups at once over about 4 m) calibrates nothing: counted and said.
-// BEACONLOC_SEED003_CDF_SVG=FILE writes the plot.
+// spherical, EKF). As in the paper, the middle value 2.5 m calibrates best; 0.5 m and 1.5 m
+// give worse transforms (two points close together), and 5 m, barely shorter than the 5.3-5.6 m
+// over which the robot hears two consecutive groups, calibrates only the groups whose
+// two points happen to fit (100 runs: 168 of 700) and those worse. Groups left uncalibrated
+// are counted and said. BEACONLOC_SEED003_CDF_SVG=FILE writes the plot.
 TEST(ScanOnSeed003, CalibrationErrorCdfOverDmin) {
   const sim::Scenario s = seed003();
   const int n = runs();
   std::vector<CdfSeries> series;
   std::map<double, std::vector<double>> errors;
+  std::map<double, std::size_t> groups_calibrated;
   for (const double d_min : {0.5, 1.5, 2.5, 5.0}) {
     std::size_t groups = 0;
     for (std::uint64_t seed = 1; seed <= static_cast<std::uint64_t>(n); ++seed) {
@@ -170,6 +181,7 @@ TEST(ScanOnSeed003, CalibrationErrorCdfOverDmin) {
       groups += r.calibration.groups.size();
       for (const auto& [id, e] : r.beacon_error_m) errors[d_min].push_back(e);
     }
+    groups_calibrated[d_min] = groups;
     std::vector<double> sorted = errors[d_min];
     std::sort(sorted.begin(), sorted.end());
     const auto quantile = [&](double q) {
@@ -183,11 +195,14 @@ TEST(ScanOnSeed003, CalibrationErrorCdfOverDmin) {
     std::snprintf(label, sizeof label, "d_min = %.1f m (%zu beacons)", d_min, sorted.size());
     series.push_back({label, sorted});
   }
-  // As Fig. 11: two points 0.5 m apart give the worst transforms of the three that calibrate.
-  EXPECT_GT(mean_of(errors[0.5]), mean_of(errors[1.5]));
-  EXPECT_GT(mean_of(errors[0.5]), mean_of(errors[2.5]));
-  EXPECT_FALSE(errors[2.5].empty());
-  EXPECT_TRUE(errors[5.0].empty());  // this building's overlaps are shorter than 5 m
+  // As Fig. 11: 2.5 m calibrates every group, and better than the lower and higher values.
+  const std::size_t all_groups = static_cast<std::size_t>(n) * s.local_group_frames_map.size();
+  EXPECT_EQ(groups_calibrated[2.5], all_groups);
+  EXPECT_LT(mean_of(errors[2.5]), mean_of(errors[0.5]));
+  EXPECT_LT(mean_of(errors[2.5]), mean_of(errors[1.5]));
+  EXPECT_LT(mean_of(errors[2.5]), mean_of(errors[5.0]));
+  EXPECT_GT(groups_calibrated[5.0], 0u);
+  EXPECT_LT(groups_calibrated[5.0], all_groups);
   if (const char* svg = std::getenv("BEACONLOC_SEED003_CDF_SVG")) {
     write_cdf_svg(svg, "seed 003: beacon calibration error over d_min", "beacon position error (m)", series);
   }
