@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <utility>
 
 #include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "beaconloc/core/speed_of_sound.hpp"
@@ -59,6 +61,42 @@ TEST(SimSource, StaticRobotTofIsTheDistanceOverTheSpeedOfSound) {
     const double d = Eigen::Vector3d(rx.x() - beacon.x(), rx.y() - beacon.y(), -beacon.z()).norm();
     EXPECT_NEAR(e.tof.tof_s, d / c, 1e-12);
   }
+}
+
+// Seed 003 Sec. 2: a group covers a circle around its centre; a receiver hears all of a
+// group's beacons inside it and none outside, whatever each beacon's own limits allow.
+TEST(SimSource, AGroupIsHeardWithinItsCoverageCircleAndNotBeyond) {
+  Scenario s = default_scenario();  // six beacons at 2.011 m, the 20 m x 20 m hemisphere limits
+  s.max_range_m = 20.0;
+  s.range_sigma_m = 0.0;
+  for (Beacon& b : s.beacons) b.group = b.position_map_m.y() < 0.0 ? 1 : 2;  // y -0.3 and 1.5
+  s.group_coverage_radius_m = 1.0;
+  const auto centres = s.group_centres_map_m();
+  ASSERT_EQ(centres.size(), 2u);
+  EXPECT_TRUE(centres.at(1).isApprox(Eigen::Vector2d(1.5, -0.3)));
+  EXPECT_TRUE(centres.at(2).isApprox(Eigen::Vector2d(1.5, 1.5)));
+  s.receivers = ReceiverArray::on_circle(0.0, 1);
+  for (const auto& [x_m, heard_group] : {std::pair{1.5, 1u}, std::pair{3.0, 0u}}) {  // 0.1 m and 1.5 m off group 1's centre
+    s.trajectory = Trajectory({x_m, -0.2, 0.0}, {{100.0, 0.0, 0.0}}, false);
+    std::set<std::uint32_t> groups;
+    int heard = 0;
+    for (const auto& e : run(s, 1, 3.0)) {
+      if (e.kind != SourceEvent::Kind::kTof) continue;
+      ++heard;
+      for (const Beacon& b : s.beacons)
+        if (b.id == e.tof.beacon_id) groups.insert(b.group);
+    }
+    if (heard_group == 0) {
+      EXPECT_EQ(heard, 0) << x_m;  // 1.5 m from group 1's centre, 2.1 m from group 2's
+    } else {
+      EXPECT_EQ(groups, std::set<std::uint32_t>{heard_group}) << x_m;  // all three of its beacons, 6 slots a cycle
+      EXPECT_GE(heard, 3 * 2) << x_m;
+    }
+  }
+  // Where the robot is nearest a locally referenced group's centre.
+  s.local_group_frames_map[2] = Pose2(1.5, 1.5, 0.0);
+  EXPECT_TRUE(s.nearest_group_is_local(1.5, 1.0));
+  EXPECT_FALSE(s.nearest_group_is_local(1.5, 0.5));
 }
 
 TEST(SimSource, MovingRobotHearsThePulseWhereItIsAtArrival) {

@@ -39,6 +39,7 @@
 
 #include "beaconloc/core/beacon_calibration.hpp"
 #include "beaconloc/core/estimator_base.hpp"
+#include "scan/calibration_covariance.hpp"
 #include "scan/frame_filter.hpp"
 #include "scan/frame_start.hpp"
 #include "scan/group_fix.hpp"
@@ -108,7 +109,12 @@ class ScanEstimator final : public EstimatorBase {
 
  private:
   ScanEstimator(const EstimatorConfig& config, const ScanParameters& params);
-  PoseBelief pose_belief() const override { return {global_.filter.pose(), global_.filter.covariance()}; }
+  PoseBelief pose_belief() const override { return {global_.filter.pose(), global_covariance()}; }
+  // The global filter's covariance, and, while no GRULPS has corrected it within overlap_end_s,
+  // the covariance of the calibrated beacon that last did: a group's beacons share one error
+  // (their transform's), which the filter, taking each range's as its own, cannot hold, however
+  // many ranges it fuses (a consider covariance: the pose is as uncertain as the beacons are).
+  Cov3 global_covariance() const;
   StartupWait waiting_for() const override { return waiting_for_; }
 
   // A beacon where a frame's filter may use it: its position in that frame and the extra
@@ -150,7 +156,7 @@ class ScanEstimator final : public EstimatorBase {
     Frame frame;
     AnalyticAverage average;
     std::vector<PointPair> track;       // every pair of the overlap, oldest first (numerical)
-    Eigen::Matrix2d global_covariance_sum = Eigen::Matrix2d::Zero();
+    CalibrationCovariance covariance;  // of the beacons' map positions, from the pairs
     std::size_t pairs = 0;
   };
 
@@ -201,6 +207,9 @@ class ScanEstimator final : public EstimatorBase {
   InputLog<RecordedInput> log_;
   bool log_full_ = false;
   std::optional<StampNs> last_grulps_correction_ns_;
+  // The covariance of the calibrated beacon that last corrected the global frame (the largest
+  // of a hyperbolic epoch's): global_covariance().
+  Eigen::Matrix2d calibrated_correction_m2_ = Eigen::Matrix2d::Zero();
   std::optional<StampNs> back_in_grulps_since_ns_;
   std::size_t calibrated_since_grulps_ = 0;
   std::size_t inverse_passes_ = 0;

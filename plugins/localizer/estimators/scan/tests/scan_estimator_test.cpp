@@ -7,6 +7,7 @@
 #include <string>
 
 #include "offline_run.hpp"
+#include "beaconloc/core/chi_square.hpp"
 #include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "scan/inverse_trajectory.hpp"
 #include "scan/scan_estimator.hpp"
@@ -285,22 +286,37 @@ TEST(ScanEstimator, ASecondRobotGivenTheCalibrationLocalizesInTheCalibratedGroup
   ASSERT_TRUE(second.use_calibration(calibration));
   TofDecoder decoder = scenario_decoder(s);
   double sum2 = 0.0;
-  std::size_t scored = 0, ok = 0;
+  std::size_t scored = 0, ok = 0, ok_outside_3_sigma = 0;
+  double ok_variance_sum = 0.0;
   for (const SourceEvent& e : simulate(s, 2, s.duration_s)) {
     if (auto in = estimator_input("robot2", e, decoder, BeaconInput::kRanges)) second.push(*in);
     // Scored where the nearest group is an LRULPS (#1 to #7).
     const bool in_lrulps = s.nearest_group_is_local(e.truth_map_base.x(), e.truth_map_base.y());
     if (e.kind != SourceEvent::Kind::kOdometry || !e.has_truth || !in_lrulps || !second.estimate()) continue;
-    sum2 += (second.estimate()->pose_map_base.head<2>() - e.truth_map_base.head<2>()).squaredNorm();
+    const PoseEstimate est = *second.estimate();
+    const Eigen::Vector2d error = est.pose_map_base.head<2>() - e.truth_map_base.head<2>();
+    sum2 += error.squaredNorm();
     ++scored;
-    ok += second.status() == PoseStatus::kOk ? 1 : 0;
+    if (est.status != PoseStatus::kOk) continue;
+    ++ok;
+    // An ok pose's covariance must own its error (NEES over chi-square(2) 99.73 %: outside its
+    // 3-sigma ellipse).
+    const Eigen::Matrix2d p = est.covariance.topLeftCorner<2, 2>();
+    ok_variance_sum += p.trace();
+    ok_outside_3_sigma += error.dot(p.ldlt().solve(error)) > kChiSquare2Dof3Sigma ? 1 : 0;
   }
   ASSERT_GT(scored, 6000u);  // ~70 s of the 98 s drive at 100 Hz
   const double rms_m = std::sqrt(sum2 / static_cast<double>(scored));
+  std::printf("second robot, ok poses: position sigma RMS %.3f m, %.1f %% outside their 3-sigma ellipse\n",
+              std::sqrt(ok_variance_sum / static_cast<double>(std::max<std::size_t>(ok, 1))),
+              100.0 * static_cast<double>(ok_outside_3_sigma) / static_cast<double>(std::max<std::size_t>(ok, 1)));
   std::printf("second robot in the calibrated groups (seed 2, 100 Hz poses): position RMS %.3f m, %.0f %% ok\n",
               rms_m, 100.0 * static_cast<double>(ok) / static_cast<double>(scored));
   EXPECT_LT(rms_m, 0.5);
   EXPECT_GT(ok, scored * 9 / 10);
+  // Never ok while wrong: an ok pose's covariance holds the calibration's error (0 % on seed 2;
+  // 56 % before the calibrated beacons' shared error was added to what the pose reports).
+  EXPECT_LT(ok_outside_3_sigma, ok / 100);
   // It calibrated nothing itself: its calibration is the one it was given.
   EXPECT_EQ(second.calibration(), calibration);
 
