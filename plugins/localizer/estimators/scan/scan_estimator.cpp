@@ -117,6 +117,17 @@ Cov3 ScanEstimator::global_covariance() const {
   return p;
 }
 
+Eigen::Matrix2d ScanEstimator::calibrated_group_covariance(std::uint32_t beacon_id) const {
+  const LocalBeacon* local = map().find_local(beacon_id);
+  Eigen::Matrix2d largest = Eigen::Matrix2d::Zero();
+  if (!local) return largest;
+  for (const auto& [id, b] : calibrated_) {
+    const LocalBeacon* other = map().find_local(id);
+    if (other && other->group == local->group && b.covariance_m2.trace() > largest.trace()) largest = b.covariance_m2;
+  }
+  return largest;
+}
+
 bool ScanEstimator::recently(const std::optional<StampNs>& stamp_ns, StampNs now_ns) const {
   return stamp_ns && now_ns - *stamp_ns <= s_to_ns(params_.overlap_end_s);
 }
@@ -218,7 +229,7 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
     if (!u.applied()) return InputResult::of(u.outcome);
     global_corrected(now);
     if (known) note_grulps_correction(now);
-    else calibrated_correction_m2_ = b->covariance_m2;
+    else calibrated_correction_m2_ = calibrated_group_covariance(r.beacon_id);
     return InputResult::ok();
   }
   const auto uncalibrated = local_.find(group);  // uncalibrated: only its own frame uses it
@@ -258,11 +269,7 @@ void ScanEstimator::process_epoch(const Epoch& epoch) {
       if (grulps) {
         note_grulps_correction(now);
       } else {
-        calibrated_correction_m2_.setZero();
-        for (const EpochEntry& e : epoch.ranges) {
-          const std::optional<FrameBeacon> b = global_beacon(e.beacon_id);
-          if (b && b->covariance_m2.trace() > calibrated_correction_m2_.trace()) calibrated_correction_m2_ = b->covariance_m2;
-        }
+        calibrated_correction_m2_ = calibrated_group_covariance(epoch.ranges.front().beacon_id);
       }
     }
     check_fix(epoch, grulps);

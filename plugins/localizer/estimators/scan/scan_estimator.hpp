@@ -115,6 +115,9 @@ class ScanEstimator final : public EstimatorBase {
   // (their transform's), which the filter, taking each range's as its own, cannot hold, however
   // many ranges it fuses (a consider covariance: the pose is as uncertain as the beacons are).
   Cov3 global_covariance() const;
+  // The largest covariance of a calibrated group's beacons (the group of beacon_id): what the
+  // global frame is as unsure of after they corrected it. Zero for a beacon not calibrated.
+  Eigen::Matrix2d calibrated_group_covariance(std::uint32_t beacon_id) const;
   StartupWait waiting_for() const override { return waiting_for_; }
 
   // A beacon where a frame's filter may use it: its position in that frame and the extra
@@ -207,8 +210,8 @@ class ScanEstimator final : public EstimatorBase {
   InputLog<RecordedInput> log_;
   bool log_full_ = false;
   std::optional<StampNs> last_grulps_correction_ns_;
-  // The covariance of the calibrated beacon that last corrected the global frame (the largest
-  // of a hyperbolic epoch's): global_covariance().
+  // The largest covariance of the calibrated group whose beacons last corrected the global
+  // frame (calibrated_group_covariance): global_covariance().
   Eigen::Matrix2d calibrated_correction_m2_ = Eigen::Matrix2d::Zero();
   std::optional<StampNs> back_in_grulps_since_ns_;
   std::size_t calibrated_since_grulps_ = 0;
