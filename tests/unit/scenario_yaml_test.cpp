@@ -98,6 +98,9 @@ TEST(ScenarioYaml, ErrorsNameTheKeyAndLine) {
             std::string::npos);
   EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {firing_order: [7]}\n").find("names beacon 7"),
             std::string::npos);
+  EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {group_coverage_radius_m: 0}\n")
+                .find("'beacon_system.group_coverage_radius_m' must be above 0"),
+            std::string::npos);
   // A pulse without a radio message carries no id either.
   EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {radio_sync: false}\n")
                 .find("'beacon_system.radio_sync' false needs identified: false"),

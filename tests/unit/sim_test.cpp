@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <utility>
 
 #include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "beaconloc/core/speed_of_sound.hpp"
@@ -59,6 +61,39 @@ TEST(SimSource, StaticRobotTofIsTheDistanceOverTheSpeedOfSound) {
     const double d = Eigen::Vector3d(rx.x() - beacon.x(), rx.y() - beacon.y(), -beacon.z()).norm();
     EXPECT_NEAR(e.tof.tof_s, d / c, 1e-12);
   }
+}
+
+// Seed 003 Sec. 2: a group covers a circle around its centre; a receiver hears every beacon of
+// the group inside it and none outside, whatever each beacon's own limits allow. Group 0 (a site
+// of one group) has no circle.
+TEST(SimSource, AGroupIsHeardWithinItsCoverageCircleAndNotBeyond) {
+  Scenario s = default_scenario();  // six beacons at 2.011 m: (0, 1.5, 3) x (-0.3, 1.5)
+  s.max_range_m = 20.0;
+  s.range_sigma_m = 0.0;
+  for (Beacon& b : s.beacons) b.group = b.position_map_m.y() < 0.0 ? 1 : 2;
+  s.group_coverage_radius_m = 1.0;
+  const auto centres = s.group_centres_map_m();
+  ASSERT_EQ(centres.size(), 2u);
+  EXPECT_TRUE(centres.at(1).isApprox(Eigen::Vector2d(1.5, -0.3)));
+  EXPECT_TRUE(centres.at(2).isApprox(Eigen::Vector2d(1.5, 1.5)));
+  s.receivers = ReceiverArray::on_circle(0.0, 1);
+  const auto heard_at = [&](double x_m, double y_m) {
+    s.trajectory = Trajectory({x_m, y_m, 0.0}, {{100.0, 0.0, 0.0}}, false);
+    std::set<std::uint32_t> ids;
+    for (const auto& e : run(s, 1, 3.0))
+      if (e.kind == SourceEvent::Kind::kTof) ids.insert(e.tof.beacon_id);
+    return ids;
+  };
+  const std::set<std::uint32_t> group_1 = {1, 2, 3}, none;
+  EXPECT_EQ(heard_at(1.5 + 0.99, -0.3), group_1);  // just inside group 1's circle: all three of it
+  EXPECT_EQ(heard_at(1.5 + 1.01, -0.3), none);     // just outside: none of it; group 2 is 2 m away
+  // A group 0 beacon is heard by its own limits alone: beacon 4, (0, 1.5), 3 m away.
+  s.beacons[3].group = 0;
+  EXPECT_EQ(heard_at(1.5 + 1.01, -0.3), std::set<std::uint32_t>{4});
+  // Where the robot is nearest a locally referenced group's centre.
+  s.local_group_frames_map[2] = Pose2(1.5, 1.5, 0.0);
+  EXPECT_TRUE(s.nearest_group_is_local(1.5, 1.0));
+  EXPECT_FALSE(s.nearest_group_is_local(1.5, 0.5));
 }
 
 TEST(SimSource, MovingRobotHearsThePulseWhereItIsAtArrival) {

@@ -1,6 +1,8 @@
 #include "scenario.hpp"
 
 #include <cmath>
+#include <optional>
+#include <utility>
 
 namespace beaconloc::sim {
 
@@ -41,6 +43,32 @@ BeaconList Scenario::beacon_list() const {
     list.group_frame.push_back({b.id, b.group, {in_group.x(), in_group.y(), b.position_map_m.z()}});
   }
   return list;
+}
+
+std::map<std::uint32_t, Eigen::Vector2d> Scenario::group_centres_map_m() const {
+  std::map<std::uint32_t, std::pair<Eigen::Vector2d, int>> sums;  // group -> (sum of x, y; beacons)
+  for (const Beacon& b : beacons) {
+    auto& [sum, count] = sums.try_emplace(b.group, Eigen::Vector2d::Zero(), 0).first->second;
+    sum += b.position_map_m.head<2>();
+    ++count;
+  }
+  std::map<std::uint32_t, Eigen::Vector2d> centres;
+  for (const auto& [group, sum_count] : sums) centres[group] = sum_count.first / sum_count.second;
+  return centres;
+}
+
+bool Scenario::nearest_group_is_local(double x_map_m, double y_map_m) const {
+  const Eigen::Vector2d p(x_map_m, y_map_m);
+  std::optional<std::uint32_t> nearest;
+  double nearest_m = INFINITY;
+  for (const auto& [group, centre] : group_centres_map_m()) {
+    const double d_m = (centre - p).norm();
+    if (d_m < nearest_m) {
+      nearest_m = d_m;
+      nearest = group;
+    }
+  }
+  return nearest && local_group_frames_map.count(*nearest) > 0;
 }
 
 bool Faults::silences(std::uint32_t beacon_id, StampNs fire_ns) const {

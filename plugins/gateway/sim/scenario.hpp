@@ -56,6 +56,11 @@ struct Scenario {
   // The beacon map the gateway publishes (and the offline runs hand over): the globally
   // referenced beacons at their map positions, the locally referenced ones in their group's frame.
   BeaconList beacon_list() const;
+  // Each beacon group's centre on the floor: the mean of its beacons' (x, y), group 0 included.
+  std::map<std::uint32_t, Eigen::Vector2d> group_centres_map_m() const;
+  // Whether the group whose centre is nearest (x_map_m, y_map_m) is locally referenced: where a
+  // robot localizes against calibrated beacons.
+  bool nearest_group_is_local(double x_map_m, double y_map_m) const;
   // Beacon system.
   std::vector<std::uint32_t> firing_order;           // beacon ids, one per slot, cycled
   StampNs slot_period_ns = 200 * kNsPerMillisecond;  // 5 Hz firing slots
@@ -71,6 +76,10 @@ struct Scenario {
   double min_range_m = 0.0;                       // a receiver hears slant ranges in [min, max]
   double max_range_m = 5.0;
   double beam_half_angle_rad = M_PI / 2;         // cone around the beacon's downward axis
+  // Seed 003 Sec. 2: a beacon group (ULPS, group != 0) covers a circle of this radius on the
+  // floor around its centre: a receiver hears the group's beacons within it and none outside
+  // (on top of the range and beam limits above). None: each beacon's own limits alone.
+  std::optional<double> group_coverage_radius_m;
   double temperature_c = 22.0;                   // true air temperature
   std::optional<double> reported_temperature_c;  // what beacons report; default: the truth
   EchoModel echo;

@@ -188,7 +188,7 @@ void read_beacon_system(const Section& root, Scenario& sc) {
   const Section s = root.child(
       "beacon_system", {"slot_period_s", "first_slot_s", "firing_order", "identified", "radio_sync", "marked_beacon_id",
                         "range_sigma_m", "tof_sigma_s", "min_range_m", "max_range_m", "beam_half_angle_deg",
-                        "temperature_c", "reported_temperature_c", "echo"});
+                        "group_coverage_radius_m", "temperature_c", "reported_temperature_c", "echo"});
   sc.slot_period_ns = duration_ns(s, "slot_period_s", 0.2);
   sc.first_slot_ns = s_to_ns(s.number("first_slot_s", 0.05, 0.0, 3600.0));
   if (s.has("firing_order")) {
@@ -215,6 +215,11 @@ void read_beacon_system(const Section& root, Scenario& sc) {
   if (sc.max_range_m <= sc.min_range_m)
     s.fail(s.join("max_range_m"), "must exceed min_range_m", s.node("max_range_m"));
   sc.beam_half_angle_rad = s.number("beam_half_angle_deg", 90.0, 0.1, 180.0) * M_PI / 180.0;
+  if (s.has("group_coverage_radius_m")) {
+    sc.group_coverage_radius_m = s.number("group_coverage_radius_m", 0.0, 0.0, kMaxRangeM);
+    if (!(*sc.group_coverage_radius_m > 0.0))
+      s.fail(s.join("group_coverage_radius_m"), "must be above 0", s.node("group_coverage_radius_m"));
+  }
   sc.temperature_c = s.number("temperature_c", 22.0, -40.0, 60.0);
   if (s.has("reported_temperature_c"))
     sc.reported_temperature_c = s.number("reported_temperature_c", 0.0, -40.0, 60.0);

@@ -47,7 +47,8 @@ SimSource::SimSource(Scenario scenario, std::uint64_t seed)
       rng_(seed),
       next_odometry_ns_(scenario_.odometry_period_ns),
       next_fire_ns_(scenario_.first_slot_ns),
-      next_scan_ns_(scenario_.laser ? scenario_.laser->period_ns : std::numeric_limits<StampNs>::max()) {}
+      next_scan_ns_(scenario_.laser ? scenario_.laser->period_ns : std::numeric_limits<StampNs>::max()),
+      group_centres_map_m_(scenario_.group_centres_map_m()) {}
 
 void SimSource::fire(StampNs fire_ns) {
   if (scenario_.firing_order.empty()) return;
@@ -69,6 +70,9 @@ void SimSource::fire(StampNs fire_ns) {
         pulse_arrival_s(scenario_.trajectory, rx_base, rx_z, beacon->position_map_m, fire_s, c);
     const Eigen::Vector2d rx_map = transform_point(scenario_.trajectory.pose_at(arrival_s), rx_base);
     if (!hears(scenario_, beacon->position_map_m, {rx_map.x(), rx_map.y(), rx_z})) continue;
+    if (scenario_.group_coverage_radius_m && beacon->group != 0 &&
+        (rx_map - group_centres_map_m_.at(beacon->group)).norm() > *scenario_.group_coverage_radius_m)
+      continue;
     SourceEvent e;
     e.kind = SourceEvent::Kind::kTof;
     e.true_beacon_id = beacon_id;

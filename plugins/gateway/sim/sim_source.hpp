@@ -5,6 +5,7 @@
 // speed-proportional noise and systematic wheel-radius / wheel-base errors; laser scans ray cast
 // on the map. Ground truth comes with every odometry sample.
 #include <cstdint>
+#include <map>
 #include <queue>
 #include <random>
 #include <vector>
@@ -54,6 +55,7 @@ class SimSource final : public Source {
   std::uint64_t slot_ = 0;
   std::uint64_t tof_sequence_ = 0;
   std::priority_queue<SourceEvent, std::vector<SourceEvent>, Later> pending_tofs_;
+  std::map<std::uint32_t, Eigen::Vector2d> group_centres_map_m_;  // for group_coverage_radius_m
 };
 
 // Arrival time of a pulse fired at fire_s from `beacon` at the receiver mounted at

@@ -110,6 +110,24 @@ bool ScanEstimator::pairs_possible(StampNs now_ns) const {
   return global_.started && !global_.relocating && recently(global_.last_correction_ns, now_ns);
 }
 
+Cov3 ScanEstimator::global_covariance() const {
+  Cov3 p = global_.filter.covariance();
+  const std::optional<StampNs> now = now_ns();
+  if (now && !recently(last_grulps_correction_ns_, *now)) p.topLeftCorner<2, 2>() += calibrated_correction_m2_;
+  return p;
+}
+
+Eigen::Matrix2d ScanEstimator::calibrated_group_covariance(std::uint32_t beacon_id) const {
+  const LocalBeacon* local = map().find_local(beacon_id);
+  Eigen::Matrix2d largest = Eigen::Matrix2d::Zero();
+  if (!local) return largest;
+  for (const auto& [id, b] : calibrated_) {
+    const LocalBeacon* other = map().find_local(id);
+    if (other && other->group == local->group && b.covariance_m2.trace() > largest.trace()) largest = b.covariance_m2;
+  }
+  return largest;
+}
+
 bool ScanEstimator::recently(const std::optional<StampNs>& stamp_ns, StampNs now_ns) const {
   return stamp_ns && now_ns - *stamp_ns <= s_to_ns(params_.overlap_end_s);
 }
@@ -211,6 +229,7 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
     if (!u.applied()) return InputResult::of(u.outcome);
     global_corrected(now);
     if (known) note_grulps_correction(now);
+    else calibrated_correction_m2_ = calibrated_group_covariance(r.beacon_id);
     return InputResult::ok();
   }
   const auto uncalibrated = local_.find(group);  // uncalibrated: only its own frame uses it
@@ -247,7 +266,11 @@ void ScanEstimator::process_epoch(const Epoch& epoch) {
     }
     if (params_.geometry == Geometry::kHyperbolic && fuse_epoch(global_, epoch, true)) {
       global_corrected(now);
-      if (grulps) note_grulps_correction(now);
+      if (grulps) {
+        note_grulps_correction(now);
+      } else {
+        calibrated_correction_m2_ = calibrated_group_covariance(epoch.ranges.front().beacon_id);
+      }
     }
     check_fix(epoch, grulps);
     return;
@@ -405,7 +428,7 @@ void ScanEstimator::add_pair(LocalGroup& l, const Eigen::Vector2d& local_receive
   const PointPair pair{local_receiver_m, transform_point(global_pose, receivers_.receivers_base_m[0])};
   l.average.add(pair);
   if (l.track.size() < AnalyticAverage::kMaxTrackPairs) l.track.push_back(pair);
-  l.global_covariance_sum += global_.filter.covariance().topLeftCorner<2, 2>();
+  l.covariance.add(pair.global_m, global_covariance());
   ++l.pairs;
 }
 
@@ -422,14 +445,14 @@ std::optional<GroupCalibration> ScanEstimator::transform_of(std::uint32_t group,
   g.stamp_ns = now_ns;
   g.transform = fit.transform->t_c;
   g.mean_error_m = fit.mean_error_m;
-  const Eigen::Matrix2d covariance = l.global_covariance_sum / static_cast<double>(l.pairs) +
-                                     0.5 * fit.mean_error_m * fit.mean_error_m * Eigen::Matrix2d::Identity();
+  // The fit's residual adds to the global frame's error at the pairs (calibration_covariance.hpp).
+  const Eigen::Matrix2d residual = 0.5 * fit.mean_error_m * fit.mean_error_m * Eigen::Matrix2d::Identity();
   for (const LocalBeacon& b : map().local_beacons()) {
     if (b.group != group) continue;
     CalibratedBeacon c;
     c.id = b.id;
     c.position_map_m << fit.transform->apply(b.position_group_m.head<2>()), b.position_group_m.z();  // eq. 42-43
-    c.covariance_m2 = 0.5 * (covariance + covariance.transpose());
+    c.covariance_m2 = l.covariance.at(c.position_map_m.head<2>()) + residual;
     g.beacons.push_back(c);
   }
   BeaconCalibration one;
@@ -456,7 +479,7 @@ void ScanEstimator::finish_overlaps(StampNs now_ns) {
     if (!g) {  // the overlap gave no transform (too short): wait for another
       l.average = AnalyticAverage(params_.d_min_m);
       l.track.clear();
-      l.global_covariance_sum.setZero();
+      l.covariance.clear();
       l.pairs = 0;
       ++it;
       continue;

@@ -39,6 +39,7 @@
 
 #include "beaconloc/core/beacon_calibration.hpp"
 #include "beaconloc/core/estimator_base.hpp"
+#include "scan/calibration_covariance.hpp"
 #include "scan/frame_filter.hpp"
 #include "scan/frame_start.hpp"
 #include "scan/group_fix.hpp"
@@ -68,10 +69,10 @@ struct ScanParameters {
   // needs the GRULPS's fixes at its start (5 s, on seed 003 at the coverage's edge, was too
   // short on one seed in four: the backwards global frame started as it left the GRULPS).
   double inverse_after_s = 10.0;
-  // The inputs kept for it (13 min of 100 Hz odometry and the ranges between: 8.6 MB); a longer
-  // leg between two GRULPSs has no backwards drive (inverse_passes_skipped counts it). The drive
-  // runs inside the odometry step that starts it: 4-40 ms for seed 003's 16 000 inputs (EKF to
-  // UKF), so up to 0.3 s at the cap (BENCHMARKS.md).
+  // The inputs kept for it (8.6 MB; 18 min of seed 003's drive, 100 Hz odometry and 12 ranges a
+  // second); a longer leg between two GRULPSs has no backwards drive (inverse_passes_skipped
+  // counts it). The drive runs inside the odometry step that starts it: 2.4 ms (EKF) for seed
+  // 003's 11 000 inputs, about 26 ms at the cap (BENCHMARKS.md).
   std::size_t max_recorded_inputs = 120000;
 
   static ScanParameters from(const EstimatorConfig& config);
@@ -108,7 +109,15 @@ class ScanEstimator final : public EstimatorBase {
 
  private:
   ScanEstimator(const EstimatorConfig& config, const ScanParameters& params);
-  PoseBelief pose_belief() const override { return {global_.filter.pose(), global_.filter.covariance()}; }
+  PoseBelief pose_belief() const override { return {global_.filter.pose(), global_covariance()}; }
+  // The global filter's covariance, and, while no GRULPS has corrected it within overlap_end_s,
+  // the covariance of the calibrated beacon that last did: a group's beacons share one error
+  // (their transform's), which the filter, taking each range's as its own, cannot hold, however
+  // many ranges it fuses (a consider covariance: the pose is as uncertain as the beacons are).
+  Cov3 global_covariance() const;
+  // The largest covariance of a calibrated group's beacons (the group of beacon_id): what the
+  // global frame is as unsure of after they corrected it. Zero for a beacon not calibrated.
+  Eigen::Matrix2d calibrated_group_covariance(std::uint32_t beacon_id) const;
   StartupWait waiting_for() const override { return waiting_for_; }
 
   // A beacon where a frame's filter may use it: its position in that frame and the extra
@@ -150,7 +159,7 @@ class ScanEstimator final : public EstimatorBase {
     Frame frame;
     AnalyticAverage average;
     std::vector<PointPair> track;       // every pair of the overlap, oldest first (numerical)
-    Eigen::Matrix2d global_covariance_sum = Eigen::Matrix2d::Zero();
+    CalibrationCovariance covariance;  // of the beacons' map positions, from the pairs
     std::size_t pairs = 0;
   };
 
@@ -201,6 +210,9 @@ class ScanEstimator final : public EstimatorBase {
   InputLog<RecordedInput> log_;
   bool log_full_ = false;
   std::optional<StampNs> last_grulps_correction_ns_;
+  // The largest covariance of the calibrated group whose beacons last corrected the global
+  // frame (calibrated_group_covariance): global_covariance().
+  Eigen::Matrix2d calibrated_correction_m2_ = Eigen::Matrix2d::Zero();
   std::optional<StampNs> back_in_grulps_since_ns_;
   std::size_t calibrated_since_grulps_ = 0;
   std::size_t inverse_passes_ = 0;

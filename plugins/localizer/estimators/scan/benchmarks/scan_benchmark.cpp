@@ -3,7 +3,7 @@
 //  - BM_ScanFrame_Range/<filter>: one range (spherical, eq. 26 with eq. 18);
 //  - BM_ScanFrame_Differences/<filter>: one epoch of a four-beacon group (hyperbolic, eq. 27 with
 //    eq. 19), the ranges moved to the epoch's end first;
-//  - BM_Scan_InverseTrajectory: the backwards drive (Sec. 3.6) over the whole 148 s drive.
+//  - BM_Scan_InverseTrajectory: the backwards drive (Sec. 3.6) over the whole seed 003 drive.
 // Each iteration updates a copy of the frame (a few hundred bytes: its cost is in the figure).
 // The paper gives no cost.
 #include <benchmark/benchmark.h>

@@ -4,6 +4,7 @@
 // replay does not roll it back, and one that does not fit the map is never used.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 
 #include "localizer_core.hpp"
@@ -61,9 +62,11 @@ TEST(ScanCalibrationSharing, WhatOneRobotCalibratesEveryRobotOfTheLocalizerUses)
   BeaconCalibration own;
   merge_calibration(own, scan_of(core, "first").calibration());
   EXPECT_EQ(site, own);
-  // Each group once, then again where the backwards drive found a better one: a handful of
-  // changes, not one per sample.
-  EXPECT_GE(core.calibration_revision(), site.groups.size());
+  // A change as a group (or two finished at one sample) is calibrated, then again where the
+  // backwards drive found a better one: a handful of changes, not one per sample.
+  std::printf("the site's calibration changed %llu times for %zu groups\n",
+              static_cast<unsigned long long>(core.calibration_revision()), site.groups.size());
+  EXPECT_GE(core.calibration_revision(), site.groups.size() / 2);
   EXPECT_LE(core.calibration_revision(), 2 * site.groups.size());
 
   // A second robot: its estimator holds every group at its first sample.

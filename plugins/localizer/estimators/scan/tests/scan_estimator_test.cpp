@@ -2,11 +2,15 @@
 // locally referenced beacon never moves the map pose until its group is calibrated, its refusals.
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "offline_run.hpp"
+#include "beaconloc/core/chi_square.hpp"
 #include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "scan/inverse_trajectory.hpp"
 #include "scan/scan_estimator.hpp"
@@ -267,40 +271,82 @@ TEST(ScanEstimator, DuplicatesFloodsAndRangesFromTheFutureAreRefusedByReason) {
   EXPECT_EQ(refused, 36);
 }
 
+// A robot (seed) driving the seed 003 path with a calibration it is given, scored where the
+// nearest group is an LRULPS (#1 to #7).
+struct CalibratedDrive {
+  std::size_t scored = 0, ok = 0;
+  std::size_t ok_outside_3_sigma = 0;  // ok poses whose error is outside their 3-sigma ellipse
+  double rms_m = NAN;
+  double ok_sigma_rms_m = NAN;  // the ok poses' position sigma
+};
+CalibratedDrive drive_with(const sim::Scenario& s, ScanEstimator& robot, std::uint64_t seed) {
+  TofDecoder decoder = scenario_decoder(s);
+  CalibratedDrive out;
+  double sum2 = 0.0, ok_variance_sum = 0.0;
+  for (const SourceEvent& e : simulate(s, seed, s.duration_s)) {
+    if (auto in = estimator_input("robot", e, decoder, BeaconInput::kRanges)) robot.push(*in);
+    const bool in_lrulps = s.nearest_group_is_local(e.truth_map_base.x(), e.truth_map_base.y());
+    if (e.kind != SourceEvent::Kind::kOdometry || !e.has_truth || !in_lrulps || !robot.estimate()) continue;
+    const PoseEstimate est = *robot.estimate();
+    const Eigen::Vector2d error = est.pose_map_base.head<2>() - e.truth_map_base.head<2>();
+    sum2 += error.squaredNorm();
+    ++out.scored;
+    if (est.status != PoseStatus::kOk) continue;
+    ++out.ok;
+    const Eigen::Matrix2d p = est.covariance.topLeftCorner<2, 2>();
+    ok_variance_sum += p.trace();
+    out.ok_outside_3_sigma += error.dot(p.ldlt().solve(error)) > kChiSquare2Dof3Sigma ? 1 : 0;
+  }
+  out.rms_m = std::sqrt(sum2 / static_cast<double>(std::max<std::size_t>(out.scored, 1)));
+  out.ok_sigma_rms_m = std::sqrt(ok_variance_sum / static_cast<double>(std::max<std::size_t>(out.ok, 1)));
+  return out;
+}
+
+BeaconCalibration calibrated_by_seed(const sim::Scenario& s, std::uint64_t seed) {
+  ScanEstimator first(config_of(s));
+  first.set_beacon_map(BeaconMap(s.beacon_list()));
+  TofDecoder decoder = scenario_decoder(s);
+  for (const SourceEvent& e : simulate(s, seed, s.duration_s)) {
+    if (auto in = estimator_input("robot", e, decoder, BeaconInput::kRanges)) first.push(*in);
+  }
+  first.finish();
+  return first.calibration();
+}
+
+double group_error_m(const sim::Scenario& s, const BeaconCalibration& c, std::uint32_t group) {
+  const BeaconMap truth(s.beacons);
+  for (const GroupCalibration& g : c.groups) {
+    if (g.group != group) continue;
+    double sum = 0.0;
+    for (const CalibratedBeacon& b : g.beacons) sum += (b.position_map_m.head<2>() - truth.find(b.id)->position_map_m.head<2>()).norm();
+    return sum / static_cast<double>(g.beacons.size());
+  }
+  return NAN;
+}
+
 // Acceptance (issue 16): a second robot given the first one's calibration localizes in the
 // calibrated groups at once, with no calibration drive of its own; its accuracy there is reported.
 TEST(ScanEstimator, ASecondRobotGivenTheCalibrationLocalizesInTheCalibratedGroupsAtOnce) {
   const sim::Scenario s = seed003();
   const BeaconMap map(s.beacon_list());
-  ScanEstimator first(config_of(s));
-  first.set_beacon_map(map);
-  for (const EstimatorInput& in : inputs(s, s.duration_s)) first.push(in);
-  first.finish();
-  const BeaconCalibration calibration = first.calibration();
+  const BeaconCalibration calibration = calibrated_by_seed(s, 1);
   ASSERT_EQ(calibration.groups.size(), s.local_group_frames_map.size());
 
   // The second robot: another seed (other noise), the same drive.
   ScanEstimator second(config_of(s));
   second.set_beacon_map(map);
   ASSERT_TRUE(second.use_calibration(calibration));
-  TofDecoder decoder = scenario_decoder(s);
-  double sum2 = 0.0;
-  std::size_t scored = 0, ok = 0;
-  for (const SourceEvent& e : simulate(s, 2, s.duration_s)) {
-    if (auto in = estimator_input("robot2", e, decoder, BeaconInput::kRanges)) second.push(*in);
-    // Scored from LRULPS #1 to #7 (x > 9 m on the first wing, y < 25 m on the second).
-    const bool in_lrulps = e.truth_map_base.x() > 9.0 && e.truth_map_base.y() < 25.0;
-    if (e.kind != SourceEvent::Kind::kOdometry || !e.has_truth || !in_lrulps || !second.estimate()) continue;
-    sum2 += (second.estimate()->pose_map_base.head<2>() - e.truth_map_base.head<2>()).squaredNorm();
-    ++scored;
-    ok += second.status() == PoseStatus::kOk ? 1 : 0;
-  }
-  ASSERT_GT(scored, 8000u);  // ~100 s of the 148 s drive at 100 Hz
-  const double rms_m = std::sqrt(sum2 / static_cast<double>(scored));
-  std::printf("second robot in the calibrated groups (seed 2, 100 Hz poses): position RMS %.3f m, %.0f %% ok\n",
-              rms_m, 100.0 * static_cast<double>(ok) / static_cast<double>(scored));
-  EXPECT_LT(rms_m, 0.5);
-  EXPECT_GT(ok, scored * 9 / 10);
+  const CalibratedDrive d = drive_with(s, second, 2);
+  ASSERT_GT(d.scored, 6000u);  // ~70 s of the 98 s drive at 100 Hz
+  std::printf("second robot in the calibrated groups (seed 2, 100 Hz poses): position RMS %.3f m, %.0f %% ok; ok "
+              "poses: position sigma RMS %.3f m, %.1f %% outside their 3-sigma ellipse\n",
+              d.rms_m, 100.0 * static_cast<double>(d.ok) / static_cast<double>(d.scored), d.ok_sigma_rms_m,
+              100.0 * static_cast<double>(d.ok_outside_3_sigma) / static_cast<double>(std::max<std::size_t>(d.ok, 1)));
+  EXPECT_LT(d.rms_m, 0.5);
+  EXPECT_GT(d.ok, d.scored * 9 / 10);
+  // Never ok while wrong: an ok pose's covariance holds the calibration's error (0 % on seed 2;
+  // 56 % before the calibrated beacons' shared error was added to what the pose reports).
+  EXPECT_LT(d.ok_outside_3_sigma, d.ok / 100);
   // It calibrated nothing itself: its calibration is the one it was given.
   EXPECT_EQ(second.calibration(), calibration);
 
@@ -314,6 +360,34 @@ TEST(ScanEstimator, ASecondRobotGivenTheCalibrationLocalizesInTheCalibratedGroup
   wrong.groups[0].group = 1;  // a GRULPS
   EXPECT_FALSE(third.use_calibration(wrong));
   EXPECT_TRUE(third.calibration().groups.empty());
+}
+
+// The same with a bad calibration: the first of seeds 1-40 whose LRULPS #4 is more than 0.5 m
+// off. A robot using it is as far off there as its beacons, and its covariance says so: never ok
+// outside its 3-sigma ellipse.
+TEST(ScanEstimator, ASecondRobotGivenABadCalibrationIsOffAndSaysSo) {
+  const sim::Scenario s = seed003();
+  std::optional<BeaconCalibration> bad;
+  std::uint64_t bad_seed = 0;
+  for (std::uint64_t seed = 1; seed <= 40 && !bad; ++seed) {
+    BeaconCalibration c = calibrated_by_seed(s, seed);
+    if (c.groups.size() == s.local_group_frames_map.size() && group_error_m(s, c, 6) > 0.5) {
+      bad = c;
+      bad_seed = seed;
+    }
+  }
+  ASSERT_TRUE(bad) << "no seed in 1-40 calibrates LRULPS #4 worse than 0.5 m";
+  ScanEstimator second(config_of(s));
+  second.set_beacon_map(BeaconMap(s.beacon_list()));
+  ASSERT_TRUE(second.use_calibration(*bad));
+  const CalibratedDrive d = drive_with(s, second, 2);
+  std::printf("calibration of seed %llu (LRULPS #4 %.3f m off), second robot: position RMS %.3f m, %.0f %% ok; ok poses: "
+              "position sigma RMS %.3f m, %.1f %% outside their 3-sigma ellipse\n",
+              static_cast<unsigned long long>(bad_seed), group_error_m(s, *bad, 6), d.rms_m,
+              100.0 * static_cast<double>(d.ok) / static_cast<double>(std::max<std::size_t>(d.scored, 1)),
+              d.ok_sigma_rms_m,
+              100.0 * static_cast<double>(d.ok_outside_3_sigma) / static_cast<double>(std::max<std::size_t>(d.ok, 1)));
+  EXPECT_LT(d.ok_outside_3_sigma, d.ok / 100);
 }
 
 TEST(InputLog, KeepsEveryItemNewestFirstAndCopiesShareTheSealedPart) {

@@ -7,6 +7,9 @@ namespace beaconloc {
 // The 99.9 % quantiles of chi-square at 1 and 3 dof: the gates of one range, one pose.
 inline constexpr double kChiSquare999OneDof = 10.83;
 inline constexpr double kChiSquare999ThreeDof = 16.27;
+// The 99.73 % quantile of chi-square at 2 dof, -2 ln(0.0027): a 2D error outside its covariance's
+// 3-sigma ellipse.
+inline constexpr double kChiSquare2Dof3Sigma = 11.83;
 
 // The 99.9 % quantile of chi-square with dof degrees of freedom, by Wilson-Hilferty: above
 // the exact value by 3 % at 1 dof, 1.2 % at 5, 0.3 % at 20.
