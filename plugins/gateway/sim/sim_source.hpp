@@ -31,9 +31,20 @@ class SimSource final : public Source {
     return scenario_.radio_sync ? BeaconInput::kRawTof : BeaconInput::kPulseArrivals;
   }
   const Scenario& scenario() const { return scenario_; }
+  // Selective activation (seed 004 Sec. 3): the beacons to fire from the next slot on, each in
+  // turn in id order (after the last one fired), instead of the scenario's firing order; nullopt
+  // returns to the firing order. Ids the scenario lacks are never fired; an empty plan is the
+  // firing order (a robot is never left blind).
+  void set_firing_plan(std::optional<std::vector<std::uint32_t>> beacon_ids);
+  struct FiringCounts {
+    std::uint64_t fired = 0;  // slots in which a beacon fired
+    std::uint64_t heard = 0;  // of those, slots in which some receiver heard it
+  };
+  FiringCounts firing_counts() const { return counts_; }
 
  private:
   void fire(StampNs fire_ns);
+  std::uint32_t next_beacon();
   SourceEvent odometry_at(StampNs stamp_ns);
   SourceEvent scan_at(StampNs stamp_ns);
   double normal() { return unit_normal_(rng_); }
@@ -53,6 +64,9 @@ class SimSource final : public Source {
   StampNs next_fire_ns_;
   StampNs next_scan_ns_;
   std::uint64_t slot_ = 0;
+  std::optional<std::vector<std::uint32_t>> plan_;
+  std::optional<std::uint32_t> last_fired_id_;
+  FiringCounts counts_;
   std::uint64_t tof_sequence_ = 0;
   std::priority_queue<SourceEvent, std::vector<SourceEvent>, Later> pending_tofs_;
   std::map<std::uint32_t, Eigen::Vector2d> group_centres_map_m_;  // for group_coverage_radius_m

@@ -1,0 +1,32 @@
+#pragma once
+// Selective activation (seed 004 Sec. 3, Fig. 3, and Sec. 4: "we measure an angle between mobile
+// robot and ultrasonic sensor, and if there is an ultrasonic generator which is out of range, we
+// don't active it"): which beacons to fire next, from the predicted pose and each beacon's reach.
+// A slot spent on a beacon no receiver can hear is a slot without a range; firing only those
+// that can reach the robot gives more ranges per second. The pose's uncertainty widens the test
+// (kFiringPlanSigmas), so that a robot whose pose is off still hears the beacons it needs, and a
+// plan that would fire nothing fires every beacon: a robot is never left blind.
+#include <cstdint>
+#include <vector>
+
+#include "beaconloc/core/beacon_map.hpp"
+#include "beaconloc/core/pose2.hpp"
+#include "beaconloc/core/receiver_array.hpp"
+
+namespace beaconloc {
+
+// How many standard deviations of the pose a beacon's reach is widened by.
+inline constexpr double kFiringPlanSigmas = 3.0;
+
+// Every beacon with a map position, in id order: the schedule without a plan.
+std::vector<std::uint32_t> fire_all(const BeaconMap& map);
+
+// The beacons, in id order, that may reach a receiver of a robot at pose_map_base (covariance:
+// its uncertainty) within `sigmas`: a receiver's position is widened by sigmas times the
+// position's largest standard deviation plus its lever arm times the heading's. Beacons whose
+// reach is not known are always in the plan; fire_all(map) when no beacon may reach the robot.
+std::vector<std::uint32_t> plan_firing(const BeaconMap& map, const ReceiverArray& receivers,
+                                       const Pose2& pose_map_base, const Cov3& covariance,
+                                       double sigmas = kFiringPlanSigmas);
+
+}  // namespace beaconloc
