@@ -1,7 +1,9 @@
 #pragma once
 // beacon-gateway participant: publishes the source's BeaconMap (transient local), then its
 // RawTof, Odometry and LaserScan samples, paced against the wall clock (x speed) or as fast as a
-// throttle lets it; writes the source's ground truth to a CSV when asked.
+// throttle lets it; writes the source's ground truth to a CSV when asked. A source that calls its
+// beacons (the simulator) fires by the FiringPlan a localizer sends for its robot while the plan
+// is fresh, and every beacon otherwise (seed 004 selective activation).
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -17,6 +19,7 @@
 #include "beaconloc/dds/diagnostics_publisher.hpp"
 #include "beaconloc/dds/participant.hpp"
 #include "beaconloc/dds/periodic_task.hpp"
+#include "firing_scheduler.hpp"
 #include "source.hpp"
 
 namespace beaconloc {
@@ -36,6 +39,9 @@ struct GatewayOptions {
   // fired, echo or not), when not empty.
   std::string record_dir;
   std::string frame_id = "map";
+  // Every firing of the source (fire_stamp_ns,beacon_id,planned,heard), as CSV, when not empty:
+  // which slots followed a localizer's firing plan (seed 004 selective activation).
+  std::string firings_csv;
   // Simulated stamps start at 0; live, they are offset to the wall clock at start. A replayed
   // recording keeps its own clock either way. false: byte-identical runs (run).
   bool wall_clock_stamps = true;
@@ -78,6 +84,11 @@ class GatewayParticipant {
  private:
   void run();
   void publish(SourceEvent& e, StampNs offset_ns);
+  // The source fires by the newest fresh firing plan, or every beacon (FiringScheduler); the
+  // firings go to the firing log.
+  void apply_firing_plan(StampNs source_now_ns);
+  void log_firings(StampNs offset_ns);
+  std::string firing_summary();
   void count(bool written);
 
   GatewayOptions options_;
@@ -96,11 +107,17 @@ class GatewayParticipant {
   std::ofstream record_tof_;
   std::ofstream record_pulse_;
   std::ofstream record_odometry_;
+  std::ofstream firings_;
+  // Selective activation: the plans for this robot, judged by the source's data time.
+  std::mutex plan_mutex_;
+  FiringScheduler scheduler_;
+  std::atomic<StampNs> source_now_ns_{0};
   std::uint64_t odometry_sequence_ = 0;
   std::mutex counts_mutex_;
   RejectionCounter counts_;  // accepted = samples written; rejected = write failures
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
   std::unique_ptr<dds::PeriodicTask> liveliness_;  // asserts the TOF and odometry writers' liveliness
+  dds::Reader plan_reader_;  // FiringPlan: after what it uses (the scheduler), so it stops first
   GatewayProgress progress_;
   std::atomic<double> elapsed_s_{0.0};
   double total_s_ = 0.0;

@@ -126,6 +126,8 @@ void SimSource::fire(StampNs fire_ns) {
     heard = true;
   }
   if (heard) ++counts_.heard;
+  if (firings_.size() >= kMaxFiringLog) firings_.erase(firings_.begin(), firings_.begin() + kMaxFiringLog / 2);
+  firings_.push_back({fire_ns, beacon_id, plan_.has_value(), heard});
 }
 
 SourceEvent SimSource::odometry_at(StampNs stamp_ns) {

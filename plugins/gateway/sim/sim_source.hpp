@@ -35,7 +35,14 @@ class SimSource final : public Source {
   // turn in id order (after the last one fired), instead of the scenario's firing order; nullopt
   // returns to the firing order. Ids the scenario lacks are never fired; an empty plan is the
   // firing order (a robot is never left blind).
-  void set_firing_plan(std::optional<std::vector<std::uint32_t>> beacon_ids);
+  bool honours_firing_plan() const override { return true; }
+  StampNs slot_period_ns() const override { return scenario_.slot_period_ns; }
+  void set_firing_plan(std::optional<std::vector<std::uint32_t>> beacon_ids) override;
+  std::vector<Firing> take_firings() override {
+    std::vector<Firing> out;
+    out.swap(firings_);
+    return out;
+  }
   struct FiringCounts {
     std::uint64_t fired = 0;  // slots in which a beacon fired
     std::uint64_t heard = 0;  // of those, slots in which some receiver heard it
@@ -67,6 +74,9 @@ class SimSource final : public Source {
   std::optional<std::vector<std::uint32_t>> plan_;
   std::optional<std::uint32_t> last_fired_id_;
   FiringCounts counts_;
+  // Firings not yet taken, at most kMaxFiringLog (a caller that never takes them keeps the newest).
+  static constexpr std::size_t kMaxFiringLog = 4096;
+  std::vector<Firing> firings_;
   std::uint64_t tof_sequence_ = 0;
   std::priority_queue<SourceEvent, std::vector<SourceEvent>, Later> pending_tofs_;
   std::map<std::uint32_t, Eigen::Vector2d> group_centres_map_m_;  // for group_coverage_radius_m

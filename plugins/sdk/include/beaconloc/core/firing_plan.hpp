@@ -12,11 +12,18 @@
 #include "beaconloc/core/beacon_map.hpp"
 #include "beaconloc/core/pose2.hpp"
 #include "beaconloc/core/receiver_array.hpp"
+#include "beaconloc/core/time.hpp"
 
 namespace beaconloc {
 
 // How many standard deviations of the pose a beacon's reach is widened by.
 inline constexpr double kFiringPlanSigmas = 3.0;
+// A localizer sends a robot's plan every 20 ms of data time (50 Hz: several plans per firing slot
+// of 50-200 ms, so that each firing follows a pose at most 20 ms old).
+inline constexpr StampNs kFiringPlanPeriodNs = 20 * kNsPerMillisecond;
+// A gateway fires every beacon again once its newest plan is this many firing slots old (the
+// localizer gone, stalled or without a pose): a robot is blind for two slots at most.
+inline constexpr int kFiringPlanStaleSlots = 2;
 
 // Every beacon with a map position, in id order: the schedule without a plan.
 std::vector<std::uint32_t> fire_all(const BeaconMap& map);
