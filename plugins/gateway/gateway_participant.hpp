@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -86,7 +87,7 @@ class GatewayParticipant {
   void publish(SourceEvent& e, StampNs offset_ns);
   // The source fires by the newest fresh firing plan, or every beacon (FiringScheduler); the
   // firings go to the firing log.
-  void apply_firing_plan(StampNs source_now_ns);
+  void apply_firing_plan(StampNs now_stamp_ns);
   void log_firings(StampNs offset_ns);
   std::string firing_summary();
   void count(bool written);
@@ -108,10 +109,14 @@ class GatewayParticipant {
   std::ofstream record_pulse_;
   std::ofstream record_odometry_;
   std::ofstream firings_;
-  // Selective activation: the plans for this robot, judged by the source's data time.
+  // Selective activation: the plans for this robot (a source that honours them), judged by the
+  // gateway's stamps; -1 until the run has started.
   std::mutex plan_mutex_;
-  FiringScheduler scheduler_;
-  std::atomic<StampNs> source_now_ns_{0};
+  std::optional<FiringScheduler> scheduler_;
+  std::uint64_t plans_ignored_ = 0;  // plans for its robot to a source that fires what it fired
+  std::uint64_t firings_planned_ = 0;  // the source's firings by a plan
+  std::uint64_t firings_every_ = 0;    // and of every beacon in turn
+  std::atomic<StampNs> now_stamp_ns_{-1};
   std::uint64_t odometry_sequence_ = 0;
   std::mutex counts_mutex_;
   RejectionCounter counts_;  // accepted = samples written; rejected = write failures

@@ -241,12 +241,12 @@ void LocalizerParticipant::publish_firing_plan(const std::string& robot_id, Stam
   if (!plan_writer_) return;
   const auto sent = plan_sent_ns_.find(robot_id);
   if (sent != plan_sent_ns_.end() && stamp_ns >= sent->second && stamp_ns - sent->second < kFiringPlanPeriodNs) return;
-  const std::optional<std::vector<std::uint32_t>> plan = core_.firing_plan(robot_id);
-  if (!plan) return;  // no pose to plan from: the gateway's plan goes stale, and it fires every beacon
+  const std::optional<FiringPlan> plan = core_.firing_plan(robot_id);
+  if (!plan) return;  // no trusted pose to plan from: the gateway's plan goes stale, and it fires every beacon
   msg::FiringPlan m;
   m.robot_id(robot_id);
-  m.stamp_ns(stamp_ns);
-  m.beacon_ids(*plan);
+  m.stamp_ns(plan->stamp_ns);
+  m.beacon_ids(plan->beacon_ids);
   plan_writer_->write(&m);
   plan_sent_ns_[robot_id] = stamp_ns;
   ++plans_sent_;

@@ -24,10 +24,12 @@ using namespace std::chrono_literals;
 constexpr double kX = 1.0, kY = 1.5;
 const std::set<std::uint32_t> kReachable = {1, 2, 4, 5, 7, 8};
 // Slot of the seed 004 scenario (50 ms), and the gateway's step (it applies the plan each 10 ms
-// of data time) and a plan's delivery after the localizer sent it (loopback, a loaded machine).
+// of data time). The gateway judges a plan by the stamp of the pose it came from, which is no
+// later than the kill (the localizer's newest odometry), however late the plan is delivered: no
+// allowance for delivery, only for the step and the clocks' granularity.
 constexpr StampNs kSlotNs = 50 * kNsPerMillisecond;
 constexpr StampNs kGatewayStepNs = 10 * kNsPerMillisecond;
-constexpr StampNs kDeliveryNs = 30 * kNsPerMillisecond;
+constexpr StampNs kClockSlackNs = 5 * kNsPerMillisecond;
 
 struct FiringRow {
   StampNs stamp_ns;
@@ -54,11 +56,13 @@ std::vector<FiringRow> read_firings(const std::string& file) {
   return rows;
 }
 
-// The number before " plans" in the gateway's Diagnostics (0 when it has none).
-std::uint64_t plans_taken(const msg::Diagnostics& d) {
+// A count in the gateway's Diagnostics message: the number before `what` (0 when absent).
+std::uint64_t count_of(const msg::Diagnostics& d, const std::string& what) {
   std::smatch m;
-  return std::regex_search(d.message(), m, std::regex("\\((\\d+) plans")) ? std::stoull(m[1]) : 0;
+  return std::regex_search(d.message(), m, std::regex("(\\d+) " + what)) ? std::stoull(m[1]) : 0;
 }
+std::uint64_t planned_firings(const msg::Diagnostics& d) { return count_of(d, "firings by plan"); }
+std::uint64_t every_beacon_firings(const msg::Diagnostics& d) { return count_of(d, "of every beacon"); }
 
 class FiringPlanOverDds : public ParticipantsTest {
  protected:
@@ -98,26 +102,29 @@ TEST_F(FiringPlanOverDds, AKilledLocalizersGatewayFiresEveryBeaconWithinTwoSlots
   ChildProcess decoder(command("decoder"), path("decoder.log"));
   auto localizer = std::make_unique<ChildProcess>(localizer_command(), path("localizer.log"));
   const std::string gateway_name = "beaconloc.gateway.robot1";
+  // The Diagnostics come once a second: each wait is for counts of firings, not for a moment.
   const auto following = wait_for_diagnostics(diagnostics, gateway_name, [](const msg::Diagnostics& d) {
-    return d.message().find("firing by plan") != std::string::npos && plans_taken(d) >= 50;
+    return d.message().find("firing by plan") != std::string::npos && planned_firings(d) >= 30;
   });
-  ASSERT_GE(plans_taken(following), 50u) << following.message() << "\n" << localizer->log();
+  ASSERT_GE(planned_firings(following), 30u) << following.message() << "\n" << localizer->log();
 
   const StampNs killed_ns = dds::wall_clock_ns();
   localizer->signal(SIGKILL);
   localizer->wait(10s);
-  const auto fell_back = wait_for_diagnostics(diagnostics, gateway_name, [](const msg::Diagnostics& d) {
-    return d.message().find("firing every beacon") != std::string::npos;
+  const std::uint64_t every_at_kill = every_beacon_firings(following);
+  const auto fell_back = wait_for_diagnostics(diagnostics, gateway_name, [&](const msg::Diagnostics& d) {
+    return d.message().find("firing every beacon") != std::string::npos &&
+           every_beacon_firings(d) >= every_at_kill + 20;
   });
-  ASSERT_NE(fell_back.message().find("firing every beacon"), std::string::npos) << fell_back.message();
-  const std::uint64_t plans_before_restart = plans_taken(fell_back);
+  ASSERT_GE(every_beacon_firings(fell_back), every_at_kill + 20) << fell_back.message();
+  const std::uint64_t planned_at_restart = planned_firings(fell_back);
 
   const StampNs restarted_ns = dds::wall_clock_ns();
   localizer = std::make_unique<ChildProcess>(localizer_command(), path("localizer2.log"));
   const auto following_again = wait_for_diagnostics(diagnostics, gateway_name, [&](const msg::Diagnostics& d) {
-    return d.message().find("firing by plan") != std::string::npos && plans_taken(d) >= plans_before_restart + 50;
+    return d.message().find("firing by plan") != std::string::npos && planned_firings(d) >= planned_at_restart + 30;
   });
-  ASSERT_NE(following_again.message().find("firing by plan"), std::string::npos)
+  ASSERT_GE(planned_firings(following_again), planned_at_restart + 30)
       << following_again.message() << "\n" << localizer->log();
   stop_cleanly(gateway, "gateway");  // its firing log is complete once it has exited
   stop_cleanly(*localizer, "localizer");
@@ -125,7 +132,7 @@ TEST_F(FiringPlanOverDds, AKilledLocalizersGatewayFiresEveryBeaconWithinTwoSlots
 
   const std::vector<FiringRow> rows = read_firings(firings);
   ASSERT_FALSE(rows.empty()) << gateway.log();
-  const StampNs fallback_by_ns = killed_ns + kFiringPlanStaleSlots * kSlotNs + kGatewayStepNs + kDeliveryNs;
+  const StampNs fallback_by_ns = killed_ns + kFiringPlanStaleSlots * kSlotNs + kGatewayStepNs + kClockSlackNs;
   std::size_t planned_before = 0, fired_all_after = 0, planned_after_restart = 0, planned_in_fallback = 0;
   std::size_t planned_heard = 0, planned_total = 0, unplanned_heard = 0, unplanned_total = 0;
   StampNs last_planned_after_kill_ns = killed_ns;  // the plan the gateway still followed
@@ -148,10 +155,10 @@ TEST_F(FiringPlanOverDds, AKilledLocalizersGatewayFiresEveryBeaconWithinTwoSlots
     }
     if (r.stamp_ns >= restarted_ns) planned_after_restart += r.planned;
   }
-  EXPECT_GT(planned_before, 20u);
+  EXPECT_GE(planned_before, 30u);
   EXPECT_EQ(planned_in_fallback, 0u) << "a planned firing later than two slots after the localizer died";
-  EXPECT_GT(fired_all_after, 9u);
-  EXPECT_GT(planned_after_restart, 20u);
+  EXPECT_GE(fired_all_after, 15u);  // 20 counted by the gateway since the kill, less the two slots
+  EXPECT_GE(planned_after_restart, 30u);
   // Every planned firing reached the robot; firing every beacon wasted three slots in nine.
   EXPECT_EQ(planned_heard, planned_total);
   EXPECT_LT(unplanned_heard, unplanned_total);

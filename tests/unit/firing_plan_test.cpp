@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 
@@ -33,8 +34,10 @@ TEST(BeaconReach, ValidOnlyForAWindowAndAConeOrNotKnownAtAll) {
 TEST(BeaconReach, TheFloorAnnulusAgreesWithReachesEverywhere) {
   const Eigen::Vector3d beacon(2.0, 1.0, 5.4);
   std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> xy(-4.0, 8.0), z(0.0, 5.0);
-  for (const BeaconReach& reach : {kSrf04, BeaconReach{0.0, 5.0, M_PI / 2}, BeaconReach{0.0, 8.0, 1.2}}) {
+  // Points below, level with and above the beacon; cones narrower and wider than pi/2.
+  std::uniform_real_distribution<double> xy(-4.0, 8.0), z(0.0, 9.0);
+  for (const BeaconReach& reach : {kSrf04, BeaconReach{0.0, 5.0, M_PI / 2}, BeaconReach{0.0, 8.0, 1.2},
+                                   BeaconReach{0.5, 6.0, 2.2}, BeaconReach{0.0, 6.0, M_PI}}) {
     int heard = 0;
     for (int i = 0; i < 20000; ++i) {
       const Eigen::Vector3d p(xy(rng), xy(rng), z(rng));
@@ -128,6 +131,21 @@ TEST(FiringPlan, FiresWhatCanReachTheRobotWidenedByItsUncertainty) {
   list.reach.erase(9);
   const std::vector<std::uint32_t> with_unknown = plan_firing(BeaconMap(list), receivers, pose, sure);
   EXPECT_TRUE(std::count(with_unknown.begin(), with_unknown.end(), 9u));
+  // A pose or covariance that says nothing narrows nothing.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Cov3 broken = sure;
+  broken(0, 0) = nan;
+  EXPECT_EQ(plan_firing(map, receivers, pose, broken), fire_all(map));
+  EXPECT_EQ(plan_firing(map, receivers, Pose2(nan, 0.5, 0.0), sure), fire_all(map));
+  EXPECT_EQ(plan_firing(map, receivers, pose, sure, nan), fire_all(map));
+  // Locally referenced beacons (seed 003, no map position): in every plan, and in fire_all.
+  BeaconList with_local = map.list();
+  with_local.group_frame.push_back({41, 7, {0.0, 0.0, 5.4}});
+  const BeaconMap local_map(with_local);
+  const std::vector<std::uint32_t> local_plan = plan_firing(local_map, receivers, pose, sure);
+  EXPECT_TRUE(std::count(local_plan.begin(), local_plan.end(), 41u));
+  EXPECT_EQ(local_plan.size(), plan.size() + 1);
+  EXPECT_EQ(fire_all(local_map).size(), map.size() + 1);
 }
 
 sim::Scenario seed004() {

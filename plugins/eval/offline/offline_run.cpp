@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "firing_scheduler.hpp"
 #include "sim/sim_source.hpp"
 
 namespace beaconloc {
@@ -123,16 +124,26 @@ FiringScheduleRun run_firing_schedule(const sim::Scenario& scenario, std::uint64
   static const std::string kRobot = "robot";
   OfflineStack stack(scenario, estimator, parameters, initial_pose);
   sim::SimSource source(scenario, seed);
+  const std::vector<std::uint32_t> every = fire_all(BeaconMap(scenario.beacon_list()));
+  FiringScheduler scheduler(scenario.slot_period_ns, {every.begin(), every.end()});
   FiringScheduleRun run;
   std::vector<SourceEvent> events;
   const StampNs end_ns = s_to_ns(scenario.duration_s);
   // Slot by slot: the plan is made from the pose just before each firing (the first slot fires
-  // at first_slot_ns), as a localizer refreshing its plan faster than the slots.
+  // at first_slot_ns), as a localizer refreshing its plan faster than the slots, and the source
+  // fires by it as the gateway does (FiringScheduler: checked, judged by its age, and every
+  // beacon after unheard planned firings).
   for (StampNs slot_ns = scenario.first_slot_ns;; slot_ns += scenario.slot_period_ns) {
-    if (schedule == FiringSchedule::kSelective) source.set_firing_plan(stack.localizer.firing_plan(kRobot));
+    if (schedule == FiringSchedule::kSelective) {
+      if (const std::optional<FiringPlan> plan = stack.localizer.firing_plan(kRobot)) {
+        scheduler.take(plan->beacon_ids, plan->stamp_ns, slot_ns);
+      }
+      source.set_firing_plan(scheduler.plan_at(slot_ns));
+    }
     const StampNs until_ns = std::min(slot_ns + scenario.slot_period_ns - 1, end_ns);
     events.clear();
     source.advance(until_ns, events);
+    for (const Source::Firing& f : source.take_firings()) scheduler.on_firing(f.planned, f.heard);
     for (const SourceEvent& e : events) {
       if (e.kind == SourceEvent::Kind::kTof) ++run.tofs;
       const std::optional<LocalizerOutput> out = stack.feed(kRobot, e);

@@ -35,7 +35,9 @@ class SimSource final : public Source {
   // turn in id order (after the last one fired), instead of the scenario's firing order; nullopt
   // returns to the firing order. Ids the scenario lacks are never fired; an empty plan is the
   // firing order (a robot is never left blind).
-  bool honours_firing_plan() const override { return true; }
+  // Only where each pulse names its beacon (radio, identified): beacons heard without an id are
+  // named by their place in the firing order (seed 002's cycle), which a plan would break.
+  bool honours_firing_plan() const override { return scenario_.radio_sync && scenario_.identified; }
   StampNs slot_period_ns() const override { return scenario_.slot_period_ns; }
   void set_firing_plan(std::optional<std::vector<std::uint32_t>> beacon_ids) override;
   std::vector<Firing> take_firings() override {

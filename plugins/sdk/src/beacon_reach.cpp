@@ -30,10 +30,17 @@ BeaconReach::Annulus BeaconReach::at_drop(double drop_m) const {
   Annulus a;
   a.inner_m = std::sqrt(std::max(0.0, min_range_m * min_range_m - drop2));
   const double by_range = max_range_m * max_range_m >= drop2 ? std::sqrt(max_range_m * max_range_m - drop2) : -1.0;
-  // The cone: off-axis angle <= half-angle. Below the beacon (drop > 0) out to drop tan(half);
-  // a cone wider than pi/2 reaches every point within range, above the beacon too.
+  // The cone: the angle off the downward axis at most the half-angle. Below the beacon (drop > 0)
+  // a cone narrower than pi/2 reaches out to drop tan(half) and nothing level or above; a wider
+  // one reaches everything below and level, and above the beacon (drop < 0) what lies beyond
+  // |drop| tan(pi - half) (nothing above for exactly pi/2, everything for pi).
   double by_beam = std::numeric_limits<double>::infinity();
-  if (beam_half_angle_rad < M_PI / 2) by_beam = drop_m > 0.0 ? drop_m * std::tan(beam_half_angle_rad) : -1.0;
+  if (beam_half_angle_rad < M_PI / 2) {
+    by_beam = drop_m > 0.0 ? drop_m * std::tan(beam_half_angle_rad) : -1.0;
+  } else if (drop_m < 0.0) {
+    if (beam_half_angle_rad == M_PI / 2) return {0.0, -1.0};
+    a.inner_m = std::max(a.inner_m, -drop_m * std::tan(M_PI - beam_half_angle_rad));
+  }
   a.outer_m = std::min(by_range, by_beam);
   return a;
 }

@@ -9,11 +9,15 @@ namespace beaconloc {
 std::vector<std::uint32_t> fire_all(const BeaconMap& map) {
   std::vector<std::uint32_t> ids;
   map.for_each([&ids](const Beacon& b) { ids.push_back(b.id); });
+  for (const LocalBeacon& b : map.local_beacons()) ids.push_back(b.id);
+  std::sort(ids.begin(), ids.end());
   return ids;
 }
 
 std::vector<std::uint32_t> plan_firing(const BeaconMap& map, const ReceiverArray& receivers,
                                        const Pose2& pose, const Cov3& covariance, double sigmas) {
+  // A pose that says nothing cannot narrow anything.
+  if (!pose.allFinite() || !covariance.allFinite() || !std::isfinite(sigmas)) return fire_all(map);
   // The position's largest standard deviation: the square root of the 2x2 block's largest
   // eigenvalue (self-adjoint solver: no factorization to fail on a singular block).
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> position(covariance.topLeftCorner<2, 2>(),
@@ -38,7 +42,12 @@ std::vector<std::uint32_t> plan_firing(const BeaconMap& map, const ReceiverArray
       }
     }
   });
-  return plan.empty() ? fire_all(map) : plan;
+  if (plan.empty()) return fire_all(map);
+  // Locally referenced beacons (seed 003): where they are in the map is not known here, so they
+  // are always fired (a group must be heard to be calibrated).
+  for (const LocalBeacon& b : map.local_beacons()) plan.push_back(b.id);
+  std::sort(plan.begin(), plan.end());
+  return plan;
 }
 
 }  // namespace beaconloc

@@ -48,20 +48,24 @@ TwoReceiverEkf::TwoReceiverEkf(const EstimatorConfig& config)
 }
 
 // Each receiver where the pose puts it: P_i = t + R(yaw) b_i, its covariance the pose's carried
-// by [I, dR/dyaw b_i].
+// by [I, dR/dyaw b_i]. Both or neither: a receiver refused leaves the pair as it was.
+// Eq. 12's independence: each receiver is given the pose's whole position uncertainty, which the
+// pair then reads back as a heading far less sure than the pose's (their shared error is not
+// held); a start is never surer than it was given.
 bool TwoReceiverEkf::place(const Pose2& pose, const Cov3& covariance) {
   const std::array<Eigen::Vector2d, 2> base = {pair_.front_base_m, pair_.rear_base_m};
+  std::array<Ekf<2>, 2> placed = receivers_;
   for (std::size_t i = 0; i < 2; ++i) {
     Eigen::Matrix<double, 2, 3> j;
     j.leftCols<2>().setIdentity();
     j.col(2) << -std::sin(pose.z()) * base[i].x() - std::cos(pose.z()) * base[i].y(),
         std::cos(pose.z()) * base[i].x() - std::sin(pose.z()) * base[i].y();
-    if (receivers_[i].reset(transform_point(pose, base[i]), j * covariance * j.transpose()) !=
-        FilterOutcome::kApplied) {
+    if (placed[i].reset(transform_point(pose, base[i]), j * covariance * j.transpose()) != FilterOutcome::kApplied) {
       return false;
     }
-    gates_[i] = GateState{};  // a new start is a guess again
   }
+  receivers_ = placed;
+  gates_ = {};  // a new start is a guess again
   return true;
 }
 
@@ -85,14 +89,16 @@ InputResult TwoReceiverEkf::predict(const OdometrySample& o) {
   const Eigen::Matrix2d wheel_covariance =
       o.wheel_velocity_covariance + params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity();
   const std::array<Eigen::Vector2d, 2> base = {pair_.front_base_m, pair_.rear_base_m};
+  std::array<Ekf<2>, 2> moved = receivers_;  // both receivers move, or neither
   for (std::size_t i = 0; i < 2; ++i) {
     const ReceiverStep s = receiver_step(pose.pose_map_base, pose.covariance(2, 2), base[i], o.wheel_velocity_right_mps,
                                          o.wheel_velocity_left_mps, wheel_covariance, o.wheel_base_m, step.dt_s);
     const LinearMotion<2, 2> motion(Eigen::Matrix2d::Identity(), Eigen::Matrix2d::Identity(), s.covariance,
                                     params_.process_noise_m2ps * step.dt_s * Eigen::Matrix2d::Identity());
-    const PredictResult predicted = receivers_[i].predict(motion, s.displacement_m, step.dt_s);
+    const PredictResult predicted = moved[i].predict(motion, s.displacement_m, step.dt_s);
     if (!predicted.applied()) return InputResult::of(predicted.outcome);
   }
+  receivers_ = moved;
   return InputResult::ok();
 }
 
