@@ -47,7 +47,9 @@ OptionSet gateway_option_set(GatewayOptions& o, std::optional<std::uint64_t>& se
       .real("--speed", o.speed, "data seconds per wall-clock second",
             real_in(GatewayOptions::kMinSpeed, GatewayOptions::kMaxSpeed))  // the gateway's own bounds
       .unsigned_number("--seed", seed, "random seed of the simulated noise (default: the scenario's)")
-      .text("--truth-out", o.truth_csv, "write ground truth CSV here");
+      .text("--truth-out", o.truth_csv, "write ground truth CSV here")
+      .text("--firings-out", o.firings_csv,
+            "write every beacon firing as CSV here (fire_stamp_ns,beacon_id,planned,heard)");
   return set;
 }
 
@@ -76,6 +78,10 @@ OptionSet localizer_option_set(LocalizerSettings& o, bool standalone) {
              "X Y YAW: where the robot starts, for estimators placed by hand (default in run and demo: "
              "the scenario's start)",
              real_in(-kMaxMapCoordinateM, kMaxMapCoordinateM))
+      .text("--firing-schedule", o.firing_schedule,
+            "all: the gateways fire every beacon in turn; selective: send each robot's gateway the beacons "
+            "that may reach it (seed 004 selective activation)",
+            [](CLI::Option* option) { option->check(CLI::IsMember({"all", "selective"})); })
       .text("--calibration-file", o.calibration_file,
             "keep the site's beacon calibration (seed 003's calibrated groups) in this file: read at start, "
             "written whenever it changes, so it survives a restart");

@@ -232,7 +232,7 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
     config.occupancy_grid = std::make_shared<const OccupancyGrid>(*source.scenario->map);
   }
   LocalizerParticipant localizer(o.dds, LocalizerCore(o.localizer.estimator, config, o.localizer.robot),
-                                 {o.localizer.calibration_file});
+                                 {o.localizer.calibration_file, o.localizer.selective_activation()});
   std::unique_ptr<bridge::BridgeParticipant> ros2_bridge;
   if (o.bridge) {
     bridge::BridgeOptions b = *o.bridge;

@@ -50,9 +50,11 @@ struct LocalizerSettings {
   std::string map_file;              // ROS map_server YAML; empty: none (or the scenario's, in run)
   std::vector<double> initial_pose;  // x, y, yaw; empty: none (or the scenario's start, in run)
   std::string calibration_file;      // the site's beacon calibration kept here; empty: on the bus only
+  std::string firing_schedule = "all";  // "selective": send the gateways firing plans (seed 004)
 
   // Throws std::invalid_argument naming the bad option. fallback: receivers when none given.
   EstimatorConfig config(const std::optional<ReceiverArray>& fallback = std::nullopt) const;
+  bool selective_activation() const { return firing_schedule == "selective"; }
   // The arguments that give the same settings to `beaconloc localizer`.
   std::vector<std::string> arguments(const std::optional<ReceiverArray>& fallback = std::nullopt) const;
 };

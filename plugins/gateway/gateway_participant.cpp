@@ -26,6 +26,10 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
       pulse_writer_(participant_.writer<msg::PulseArrivalPubSubType>(dds::kPulseArrivalTopic)),
       odometry_writer_(participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic)),
       scan_writer_(participant_.writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic)) {
+  if (source_->honours_firing_plan()) {
+    const std::vector<std::uint32_t> every = fire_all(source_->beacon_map());
+    scheduler_.emplace(source_->slot_period_ns(), std::set<std::uint32_t>(every.begin(), every.end()));
+  }
   if (!(options_.speed == 0.0 ||
         (options_.speed >= GatewayOptions::kMinSpeed && options_.speed <= GatewayOptions::kMaxSpeed))) {
     std::ostringstream why;
@@ -67,14 +71,42 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
     pulse_writer_->assert_liveliness();
     odometry_writer_->assert_liveliness();
   });
+  if (!options_.firings_csv.empty()) {
+    firings_.open(options_.firings_csv);
+    if (!firings_) throw std::runtime_error("cannot write firings file '" + options_.firings_csv + "'");
+    firings_ << "fire_stamp_ns,beacon_id,planned,heard\n";
+  }
+  plan_reader_ = participant_.subscribe<msg::FiringPlanPubSubType>(dds::kFiringPlanTopic, [this](const msg::FiringPlan& m) {
+    if (m.robot_id() != options_.robot_id) return;  // another robot's gateway fires by it
+    const StampNs now_ns = now_stamp_ns_.load();
+    if (now_ns < 0) return;  // not running yet: no plan can be for its samples
+    std::lock_guard<std::mutex> lock(plan_mutex_);
+    if (scheduler_) {
+      scheduler_->take(m.beacon_ids(), m.stamp_ns(), now_ns);
+    } else {
+      ++plans_ignored_;  // not a fault of the plan: said in the Diagnostics message
+    }
+  });
   diagnostics_ = std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] {
-    std::lock_guard<std::mutex> lock(counts_mutex_);
-    RejectionCounter counts = counts_;
+    RejectionCounter counts;
+    {
+      std::lock_guard<std::mutex> lock(counts_mutex_);
+      counts = counts_;
+    }
     counts.add_rejections(source_->input_rejections(), "source.");
+    const std::string firing = firing_summary();
+    {
+      std::lock_guard<std::mutex> lock(plan_mutex_);
+      if (scheduler_) {
+        for (const auto& [refusal, n] : scheduler_->refusals()) {
+          counts.reject(std::string("firing_plan.") + to_string(refusal), n);
+        }
+      }
+    }
     return dds::make_diagnostics(
         participant_.name(), dds::wall_clock_ns(), counts, 0,
         counts.rejected_total() ? msg::PARTICIPANT_STATUS_DEGRADED : msg::PARTICIPANT_STATUS_OK,
-        source_->describe() + ", robot " + options_.robot_id);
+        source_->describe() + ", robot " + options_.robot_id + firing);
   });
 }
 
@@ -175,6 +207,46 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
   progress_.newest_stamp_ns = stamp;
 }
 
+std::string GatewayParticipant::firing_summary() {
+  std::lock_guard<std::mutex> lock(plan_mutex_);
+  if (!scheduler_) {
+    return plans_ignored_ ? ", " + std::to_string(plans_ignored_) + " firing plans ignored (the source fires what it recorded)"
+                          : "";
+  }
+  return std::string(scheduler_->following_plan() ? ", firing by plan" : ", firing every beacon") + " (" +
+         std::to_string(scheduler_->plans_taken()) + " plans, " + std::to_string(scheduler_->stale_fallbacks()) +
+         " fallbacks on stale plans, " + std::to_string(scheduler_->unheard_fallbacks()) +
+         " on unheard planned firings; " + std::to_string(firings_planned_) + " firings by plan, " +
+         std::to_string(firings_every_) + " of every beacon)";
+}
+
+void GatewayParticipant::apply_firing_plan(StampNs now_stamp_ns) {
+  now_stamp_ns_ = now_stamp_ns;
+  if (!scheduler_) return;
+  std::optional<std::vector<std::uint32_t>> plan;
+  {
+    std::lock_guard<std::mutex> lock(plan_mutex_);
+    plan = scheduler_->plan_at(now_stamp_ns);
+  }
+  source_->set_firing_plan(std::move(plan));
+}
+
+void GatewayParticipant::log_firings(StampNs offset_ns) {
+  const std::vector<Source::Firing> firings = source_->take_firings();
+  if (firings.empty()) return;
+  {
+    std::lock_guard<std::mutex> lock(plan_mutex_);
+    for (const Source::Firing& f : firings) {
+      (f.planned ? firings_planned_ : firings_every_) += 1;
+      if (scheduler_) scheduler_->on_firing(f.planned, f.heard);
+    }
+  }
+  if (!firings_.is_open()) return;
+  for (const Source::Firing& f : firings) {
+    firings_ << f.fire_stamp_ns + offset_ns << ',' << f.beacon_id << ',' << f.planned << ',' << f.heard << '\n';
+  }
+}
+
 void GatewayParticipant::run() {
   using clock = std::chrono::steady_clock;
   // Simulated stamps start at 0: offset them to the wall clock at start, so live consumers see
@@ -195,7 +267,9 @@ void GatewayParticipant::run() {
   const auto wall_start = clock::now();
   for (StampNs t_ns = begin_ns; !stop_ && !(bounded && t_ns - step_ns >= last_ns); t_ns += step_ns) {
     events.clear();
+    apply_firing_plan(std::max<StampNs>(0, t_ns - step_ns + offset_ns));
     source_->advance(bounded ? std::min(t_ns, last_ns) : t_ns, events);
+    log_firings(offset_ns);
     if (options_.speed > 0.0) {
       // Capped at 30 years of waiting (a recording of absurd length at the slowest speed), so
       // that the offset is a representable time whatever the stamps.
@@ -210,7 +284,7 @@ void GatewayParticipant::run() {
     if (throttle_) throttle_();
     if (source_->exhausted()) break;
   }
-  for (auto* file : {&truth_, &record_tof_, &record_odometry_}) {
+  for (auto* file : {&truth_, &record_tof_, &record_odometry_, &firings_}) {
     if (file->is_open() && !file->flush()) failure_ = "writing the gateway's output files failed";
   }
   diagnostics_->publish_now();

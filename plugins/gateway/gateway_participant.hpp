@@ -1,7 +1,9 @@
 #pragma once
 // beacon-gateway participant: publishes the source's BeaconMap (transient local), then its
 // RawTof, Odometry and LaserScan samples, paced against the wall clock (x speed) or as fast as a
-// throttle lets it; writes the source's ground truth to a CSV when asked.
+// throttle lets it; writes the source's ground truth to a CSV when asked. A source that calls its
+// beacons (the simulator) fires by the FiringPlan a localizer sends for its robot while the plan
+// is fresh, and every beacon otherwise (seed 004 selective activation).
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -10,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -17,6 +20,7 @@
 #include "beaconloc/dds/diagnostics_publisher.hpp"
 #include "beaconloc/dds/participant.hpp"
 #include "beaconloc/dds/periodic_task.hpp"
+#include "firing_scheduler.hpp"
 #include "source.hpp"
 
 namespace beaconloc {
@@ -36,6 +40,9 @@ struct GatewayOptions {
   // fired, echo or not), when not empty.
   std::string record_dir;
   std::string frame_id = "map";
+  // Every firing of the source (fire_stamp_ns,beacon_id,planned,heard), as CSV, when not empty:
+  // which slots followed a localizer's firing plan (seed 004 selective activation).
+  std::string firings_csv;
   // Simulated stamps start at 0; live, they are offset to the wall clock at start. A replayed
   // recording keeps its own clock either way. false: byte-identical runs (run).
   bool wall_clock_stamps = true;
@@ -78,6 +85,11 @@ class GatewayParticipant {
  private:
   void run();
   void publish(SourceEvent& e, StampNs offset_ns);
+  // The source fires by the newest fresh firing plan, or every beacon (FiringScheduler); the
+  // firings go to the firing log.
+  void apply_firing_plan(StampNs now_stamp_ns);
+  void log_firings(StampNs offset_ns);
+  std::string firing_summary();
   void count(bool written);
 
   GatewayOptions options_;
@@ -96,11 +108,21 @@ class GatewayParticipant {
   std::ofstream record_tof_;
   std::ofstream record_pulse_;
   std::ofstream record_odometry_;
+  std::ofstream firings_;
+  // Selective activation: the plans for this robot (a source that honours them), judged by the
+  // gateway's stamps; -1 until the run has started.
+  std::mutex plan_mutex_;
+  std::optional<FiringScheduler> scheduler_;
+  std::uint64_t plans_ignored_ = 0;  // plans for its robot to a source that fires what it fired
+  std::uint64_t firings_planned_ = 0;  // the source's firings by a plan
+  std::uint64_t firings_every_ = 0;    // and of every beacon in turn
+  std::atomic<StampNs> now_stamp_ns_{-1};
   std::uint64_t odometry_sequence_ = 0;
   std::mutex counts_mutex_;
   RejectionCounter counts_;  // accepted = samples written; rejected = write failures
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
   std::unique_ptr<dds::PeriodicTask> liveliness_;  // asserts the TOF and odometry writers' liveliness
+  dds::Reader plan_reader_;  // FiringPlan: after what it uses (the scheduler), so it stops first
   GatewayProgress progress_;
   std::atomic<double> elapsed_s_{0.0};
   double total_s_ = 0.0;

@@ -2,6 +2,7 @@
 // What a beacon-gateway publishes, from whichever source: the simulator, a replayed recording
 // (or, later, the hardware). DDS-free.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,22 @@ class Source {
   virtual BeaconInput beacon_input() const { return BeaconInput::kRawTof; }
   // Input the source refused while reading it (a recording's malformed rows), by reason.
   virtual RejectionCounter input_rejections() const { return {}; }
+
+  // Selective activation (seed 004 Sec. 3): whether the source fires the beacons a plan names
+  // (the simulator, hardware that calls its beacons), and the firing slot it judges a plan's age
+  // by. A recording fired what it fired: it honours none.
+  virtual bool honours_firing_plan() const { return false; }
+  virtual StampNs slot_period_ns() const { return 0; }
+  // The beacons to fire from the next slot on; nullopt: every beacon in turn.
+  virtual void set_firing_plan(std::optional<std::vector<std::uint32_t>> /*beacon_ids*/) {}
+  // The firings since last asked (for a firing log), and whether each followed a plan.
+  struct Firing {
+    StampNs fire_stamp_ns = 0;
+    std::uint32_t beacon_id = 0;
+    bool planned = false;  // chosen by a plan, not by the firing order
+    bool heard = false;    // some receiver heard it
+  };
+  virtual std::vector<Firing> take_firings() { return {}; }
 };
 
 }  // namespace beaconloc

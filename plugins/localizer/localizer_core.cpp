@@ -366,6 +366,16 @@ std::optional<StartupWait> LocalizerCore::startup_wait(const std::string& robot_
   return it->second.fusion.estimator().startup_wait();
 }
 
+std::optional<FiringPlan> LocalizerCore::firing_plan(const std::string& robot_id) const {
+  const Estimator* e = estimator(robot_id);
+  if (!e || map_.size() == 0) return std::nullopt;
+  const std::optional<PoseEstimate> pose = e->estimate();
+  // Only a trusted pose narrows the firing: a degraded one (no correction for a second, ranges
+  // that contradict it) may be off by more than its covariance says.
+  if (!pose || pose->status != PoseStatus::kOk || !publishable(*pose)) return std::nullopt;
+  return FiringPlan{pose->stamp_ns, plan_firing(map_, config_.receivers, pose->pose_map_base, pose->covariance)};
+}
+
 StartupSummary LocalizerCore::startup_summary() const {
   StartupSummary s;
   for (const auto& [id, r] : robots_) {  // by robot id

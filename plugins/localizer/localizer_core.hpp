@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "beaconloc/core/estimator.hpp"
+#include "beaconloc/core/firing_plan.hpp"
 #include "beaconloc/core/out_of_sequence_fusion.hpp"
 #include "beaconloc/core/rejection_counter.hpp"
 
@@ -127,6 +128,10 @@ class LocalizerCore {
   PoseStatus worst_status() const;
   // The robot's start-up condition while it has no pose (nullopt once it has one, or unknown).
   std::optional<StartupWait> startup_wait(const std::string& robot_id) const;
+  // Selective activation (seed 004 Sec. 3): the beacons to fire next for the robot, from its
+  // pose and each beacon's reach (core/firing_plan.hpp); nullopt while the robot has no pose
+  // that is ok (initializing, degraded or lost: every beacon must fire) or there is no map.
+  std::optional<FiringPlan> firing_plan(const std::string& robot_id) const;
   StartupSummary startup_summary() const;
 
  private:

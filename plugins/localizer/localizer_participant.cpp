@@ -6,6 +6,7 @@
 #include <chrono>
 
 #include "beaconloc/core/calibration_store.hpp"
+#include "beaconloc/core/firing_plan.hpp"
 #include "beaconloc/dds/convert.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
 
@@ -68,7 +69,9 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       participant_(dds, "beaconloc.localizer." + core_.estimator_name()),
       pose_writer_(participant_.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic)),
       state_writer_(participant_.writer<msg::EstimatorStatePubSubType>(dds::kEstimatorStateTopic)),
-      calibration_writer_(participant_.writer<msg::BeaconCalibrationPubSubType>(dds::kBeaconCalibrationTopic)) {
+      calibration_writer_(participant_.writer<msg::BeaconCalibrationPubSubType>(dds::kBeaconCalibrationTopic)),
+      plan_writer_(options_.selective_activation ? participant_.writer<msg::FiringPlanPubSubType>(dds::kFiringPlanTopic)
+                                                 : dds::Writer()) {
   own_calibration_writer_ = dds::writer_id(calibration_writer_->get_instance_handle());
   if (!options_.calibration_file.empty() && !core_.uses_calibration()) {
     throw CalibrationFileError("calibration file " + options_.calibration_file + ": the estimator " +
@@ -224,11 +227,29 @@ void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
         last->second = seq;
       }
     }
-    if (auto out = core_.on_odometry(m.robot_id(), dds::from_msg(m))) publish(*out);
+    if (auto out = core_.on_odometry(m.robot_id(), dds::from_msg(m))) {
+      publish(*out);
+      publish_firing_plan(m.robot_id(), out->estimate.stamp_ns);
+    }
     share_calibration();
     newest_odometry_stamp_ns_ = std::max(newest_odometry_stamp_ns_.load(), m.stamp_ns());
   }
   ++odometry_processed_;
+}
+
+void LocalizerParticipant::publish_firing_plan(const std::string& robot_id, StampNs stamp_ns) {
+  if (!plan_writer_) return;
+  const auto sent = plan_sent_ns_.find(robot_id);
+  if (sent != plan_sent_ns_.end() && stamp_ns >= sent->second && stamp_ns - sent->second < kFiringPlanPeriodNs) return;
+  const std::optional<FiringPlan> plan = core_.firing_plan(robot_id);
+  if (!plan) return;  // no trusted pose to plan from: the gateway's plan goes stale, and it fires every beacon
+  msg::FiringPlan m;
+  m.robot_id(robot_id);
+  m.stamp_ns(plan->stamp_ns);
+  m.beacon_ids(plan->beacon_ids);
+  plan_writer_->write(&m);
+  plan_sent_ns_[robot_id] = stamp_ns;
+  ++plans_sent_;
 }
 
 void LocalizerParticipant::publish(const LocalizerOutput& out) {
@@ -313,6 +334,7 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
     message += "; beacon map replaced " + std::to_string(core_.beacon_map_changes()) +
                " time(s), every robot restarted on it";
   }
+  if (plan_writer_) message += "; selective activation: " + std::to_string(plans_sent_) + " firing plan(s) sent";
   if (!core_.calibration().groups.empty()) {
     message += "; beacon calibration: " + std::to_string(core_.calibration().groups.size()) + " group(s)";
   }

@@ -29,6 +29,10 @@ struct LocalizerParticipantOptions {
   // be read or fails its checks stops the start with the reason), written again whenever the
   // calibration changes. Empty: the calibration lives on the bus alone.
   std::string calibration_file;
+  // Selective activation (seed 004 Sec. 3): send each robot's gateway a FiringPlan, the beacons
+  // that may reach the robot (LocalizerCore::firing_plan), every kFiringPlanPeriodNs of data time
+  // while the robot has a pose. Off: the gateways fire every beacon.
+  bool selective_activation = false;
 };
 
 // A calibration file that exists and cannot be used: the start is refused, with the reason.
@@ -58,6 +62,7 @@ class LocalizerParticipant {
   msg::Diagnostics diagnostics_snapshot();
   void on_odometry(const msg::Odometry& odometry);
   void publish(const LocalizerOutput& out);  // under mutex_
+  void publish_firing_plan(const std::string& robot_id, StampNs stamp_ns);  // under mutex_
   void on_peer_diagnostics(const msg::Diagnostics& d, const std::string& writer);
   // The site's calibration, when it changed (a robot calibrated a group, another localizer's
   // arrived): on the bus, and into the calibration file. Under mutex_.
@@ -96,11 +101,14 @@ class LocalizerParticipant {
   std::uint64_t calibrations_refused_too_large_ = 0;  // more groups or beacons than kMaxBeacons
   std::uint64_t calibrations_refused_other_frame_ = 0;  // frame_id not the beacon map's
   std::string calibration_save_error_;             // the last failure, while the newest is unsaved
+  std::map<std::string, StampNs> plan_sent_ns_;    // stamp of the pose each robot's last plan came from
+  std::uint64_t plans_sent_ = 0;
   // The entities, owned: the readers, declared last, stop first, before what they use goes.
   dds::Participant participant_;
   dds::Writer pose_writer_;
   dds::Writer state_writer_;  // EstimatorState: what the estimator holds beside the pose
   dds::Writer calibration_writer_;  // BeaconCalibration: the site's calibrated beacon groups
+  dds::Writer plan_writer_;         // FiringPlan, with selective activation
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
   std::vector<dds::Reader> readers_;
 };

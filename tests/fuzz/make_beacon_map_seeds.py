@@ -14,12 +14,16 @@ def beacon_map(frame, beacons, big_endian=False):
     body += struct.pack(e + "I", len(name)) + name
     body += b"\0" * (-len(body) % 4)
     body += struct.pack(e + "I", len(beacons))
-    for beacon_id, x, y, z, group in beacons:
+    for beacon in beacons:
+        beacon_id, x, y, z, group = beacon[:5]
+        reach = beacon[5] if len(beacon) > 5 else (0.0, 0.0, 0.0)  # min, max, half-angle: 0 = not known
         body += b"\0" * (-len(body) % 4)
         body += struct.pack(e + "I", beacon_id)
         body += b"\0" * (-len(body) % 8)
         body += struct.pack(e + "ddd", x, y, z)
-        body += struct.pack(e + "I", group)
+        body += struct.pack(e + "II", group, 0)  # group, frame BEACON_FRAME_MAP
+        body += b"\0" * (-len(body) % 8)
+        body += struct.pack(e + "ddd", *reach)
     return bytes([0, 0 if big_endian else 1, 0, 0]) + bytes(body)
 
 
@@ -34,6 +38,10 @@ def main():
         "duplicate_id.bin": beacon_map("map", [(4, 0.0, 0.0, 2.0, 0), (4, 3.0, 0.0, 2.0, 1)]),
         "non_finite.bin": beacon_map("map", [(1, math.nan, 0.0, 2.0, 0), (2, math.inf, -math.inf, 2.0, 0)]),
         "absurd.bin": beacon_map("", [(0xFFFFFFFF, 1e300, -1e300, 5e-324, 0xFFFFFFFF)]),
+        "seed004_reach.bin": beacon_map("map", [(1, -0.5, 0.3, 5.4, 0, (3.5, 5.0, 0.5236)),
+                                                 (2, 2.0, 0.3, 5.4, 0, (0.0, 0.0, 0.0))]),
+        "bad_reach.bin": beacon_map("map", [(1, 0.0, 0.0, 5.4, 0, (5.0, 3.5, math.nan)),
+                                             (2, 2.0, 0.0, 5.4, 0, (-1.0, 1e300, 7.0))]),
     }
     for name, data in seeds.items():
         with open(os.path.join(out, name), "wb") as f:

@@ -21,11 +21,13 @@ namespace {
 using Reason = EstimatorParameterError::Reason;
 
 // A configuration every registered estimator can be created with (ring receivers for duhl and
-// uhl_last2, one receiver and a map for ukf_lrf, one receiver at the centre for kleeman_iekf).
+// uhl_last2, one receiver and a map for ukf_lrf, one receiver at the centre for kleeman_iekf,
+// two for two_receiver_ekf).
 EstimatorConfig config_for(const std::string& estimator, std::map<std::string, double> parameters) {
   EstimatorConfig c;
   const bool one_at_centre = estimator.rfind("ukf_lrf", 0) == 0 || estimator == "kleeman_iekf" || estimator == "scan";
   c.receivers = ReceiverArray::on_circle(one_at_centre ? 0.0 : 0.19, one_at_centre ? 1 : 3);
+  if (estimator == "two_receiver_ekf") c.receivers = ReceiverArray::on_circle(0.133, 2);  // front and rear
   c.occupancy_grid = std::make_shared<const OccupancyGrid>(Eigen::Vector2d::Zero(), 0.1, 40, 40);
   c.parameters = std::move(parameters);
   return c;

@@ -8,6 +8,7 @@
 #include "beaconloc/core/models/arrival_time_model.hpp"
 #include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "beaconloc/core/models/laser_beam_model.hpp"
+#include "beaconloc/core/models/point_range_model.hpp"
 #include "beaconloc/core/models/pose_observation_model.hpp"
 #include "beaconloc/core/models/range_difference_model.hpp"
 #include "beaconloc/core/models/range_model.hpp"
@@ -76,6 +77,25 @@ TEST(RangeModel, DynamicStateGivesTheSameAsAFixedOne) {
   EXPECT_EQ(b.jacobian.cols(), 5);
   EXPECT_EQ(a.jacobian, b.jacobian.leftCols(3));
   EXPECT_EQ(b.jacobian.rightCols(2).norm(), 0.0);
+}
+
+TEST(PointRangeModel, JacobianMatchesNumericWithThePointAnywhereInTheState) {
+  const StateSpace<2> plane;
+  const PointRangeModel model(1.0, {2.0, 1.5, 5.4}, 1e-4);
+  for (const Vec<2>& x : {Vec<2>(0.5, 0.5), Vec<2>(2.0, 1.5), Vec<2>(-3.0, 4.0)}) {
+    expect_jacobian_matches(model, plane, x, 1e-8);
+  }
+  // [v, y, x]: the point at other indices; h is the 3D distance at the point's height.
+  const StateSpace<3> three;
+  const PointRangeModel elsewhere(1.0, {2.0, 1.5, 5.4}, 1e-4, PointIndex{2, 1});
+  const Vec<3> x(7.0, 0.5, 0.3);
+  expect_jacobian_matches(elsewhere, three, x, 1e-8);
+  EXPECT_NEAR(elsewhere.predict(x)(0), std::sqrt(1.7 * 1.7 + 1.0 * 1.0 + 4.4 * 4.4), 1e-12);
+  EXPECT_EQ(elsewhere.linearize(x).jacobian(0, 0), 0.0);
+  EXPECT_EQ(model.noise()(0, 0), 1e-4);
+  // Right under the beacon at its height: no gradient, and no NaN.
+  const PointRangeModel at_beacon(5.4, {2.0, 1.5, 5.4}, 1e-4);
+  EXPECT_TRUE(at_beacon.linearize(Vec<2>(2.0, 1.5)).jacobian.isZero());
 }
 
 TEST(RangeDifferenceModel, JacobianMatchesNumericAndNoiseIsEq19) {

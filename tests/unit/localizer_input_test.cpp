@@ -151,20 +151,25 @@ TEST(BeaconMapFromTheBus, MalformedMapsAreRefusedByReasonAndTheMapInUseKept) {
   const std::vector<Beacon> good = robot.scenario.beacons;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   struct Case {
-    std::vector<Beacon> beacons;
+    BeaconList beacons;
     const char* reason;
   };
   std::vector<Case> cases;
   cases.push_back({good, "beacon_map.duplicate_id"});
-  cases.back().beacons.push_back(good[2]);
+  cases.back().beacons.map_frame.push_back(good[2]);
   cases.push_back({good, "beacon_map.non_finite_position"});
-  cases.back().beacons[1].position_map_m.y() = nan;
+  cases.back().beacons.map_frame[1].position_map_m.y() = nan;
   cases.push_back({good, "beacon_map.position_out_of_range"});
-  cases.back().beacons[0].position_map_m.x() = 1e300;
+  cases.back().beacons.map_frame[0].position_map_m.x() = 1e300;
   cases.push_back({good, "beacon_map.reserved_id"});
-  cases.back().beacons[3].id = kBeaconUnidentified;
-  cases.push_back({{}, "beacon_map.empty"});
+  cases.back().beacons.map_frame[3].id = kBeaconUnidentified;
+  cases.push_back({BeaconList{}, "beacon_map.empty"});
   cases.push_back({std::vector<Beacon>(kMaxBeacons + 1), "beacon_map.too_many_beacons"});
+  // A beacon's reach (seed 004) that is no window and cone, or given for a beacon not in the map.
+  cases.push_back({good, "beacon_map.bad_reach"});
+  cases.back().beacons.reach[good[0].id] = BeaconReach{5.0, 3.5, nan};
+  cases.push_back({good, "beacon_map.reach_without_beacon"});
+  cases.back().beacons.reach[12345] = BeaconReach{0.0, 5.0, 0.5};
   for (const Case& c : cases) {
     EXPECT_FALSE(robot.core.on_beacon_map(c.beacons)) << c.reason;
     EXPECT_EQ(robot.core.counts().rejected(c.reason), 1u) << c.reason;

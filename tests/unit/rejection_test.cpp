@@ -40,14 +40,20 @@ TEST(Rejection, EveryFilterOutcomeHasItsReason) {
 const BeaconMap kMap({{1, {0.0, 0.0, 2.5}, 0}, {2, {3.0, 0.0, 2.5}, 0}, {3, {1.5, 2.0, 2.5}, 0}});
 
 // An estimator as the localizer makes it, whichever receivers and map it needs: three receivers
-// on a circle first (seed 000), else one receiver with an occupancy grid and a placed pose
-// (seed 001); both configs carry an initial pose, which the others ignore.
+// on a circle first (seed 000), else two, front and rear (seed 004), else one receiver with an
+// occupancy grid and a placed pose (seed 001); all carry an initial pose, which some ignore.
 std::unique_ptr<Estimator> make(const std::string& name) {
   EstimatorConfig ring;
   ring.receivers = ReceiverArray::on_circle(0.19, 3);
   ring.initial_pose = Pose2(1.0, 1.0, 0.0);
   try {
     return EstimatorRegistry::instance().create(name, ring);
+  } catch (const std::invalid_argument&) {
+  }
+  EstimatorConfig pair = ring;  // seed 004: front and rear
+  pair.receivers.receivers_base_m = {{0.133, 0.0}, {-0.133, 0.0}};
+  try {
+    return EstimatorRegistry::instance().create(name, pair);
   } catch (const std::invalid_argument&) {
   }
   EstimatorConfig single = ring;

@@ -88,7 +88,7 @@ class LocalizerCommand : public Command {
       return 0;
     }
     LocalizerParticipant participant(dds_, LocalizerCore(settings_.estimator, settings_.config(), settings_.robot),
-                                     {settings_.calibration_file});
+                                     {settings_.calibration_file, settings_.selective_activation()});
     run_until_stopped();
     return 0;
   }

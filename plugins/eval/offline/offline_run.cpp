@@ -1,25 +1,30 @@
 #include "offline_run.hpp"
 
 #include <algorithm>
+#include <Eigen/Cholesky>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <random>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
+#include "firing_scheduler.hpp"
 #include "sim/sim_source.hpp"
 
 namespace beaconloc {
 
 namespace {
 
-EstimatorConfig config_for(const sim::Scenario& scenario, const std::map<std::string, double>& parameters) {
+EstimatorConfig config_for(const sim::Scenario& scenario, const std::map<std::string, double>& parameters,
+                           const std::optional<Pose2>& initial_pose) {
   EstimatorConfig config;
   config.receivers = scenario.receivers;
   config.parameters = parameters;
   if (scenario.map) config.occupancy_grid = std::make_shared<const OccupancyGrid>(*scenario.map);
-  config.initial_pose = scenario.trajectory.pose_at(0.0);  // placed by hand, as in seed 001
+  // Placed by hand, as in seed 001: where it starts, unless told otherwise.
+  config.initial_pose = initial_pose ? *initial_pose : scenario.trajectory.pose_at(0.0);
   return config;
 }
 
@@ -47,8 +52,8 @@ std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t s
 }
 
 OfflineStack::OfflineStack(const sim::Scenario& scenario, const std::string& estimator,
-                           const std::map<std::string, double>& parameters)
-    : localizer(estimator, config_for(scenario, parameters)), decoder(decoder_config_for(scenario)) {
+                           const std::map<std::string, double>& parameters, std::optional<Pose2> initial_pose)
+    : localizer(estimator, config_for(scenario, parameters, initial_pose)), decoder(decoder_config_for(scenario)) {
   localizer.set_beacon_map(BeaconMap(scenario.beacon_list()));
   decoder.set_beacon_map(BeaconMap(scenario.beacon_list()));
 }
@@ -98,6 +103,65 @@ std::optional<LocalizerOutput> OfflineStack::feed(const std::string& robot_id, c
   // Ranges never associated (refused, or a mode without beacons) are forgotten after 10 s.
   range_truth_.erase(range_truth_.begin(), range_truth_.lower_bound(e.stamp_ns - 10'000'000'000));
   return pose;
+}
+
+std::optional<double> FiringScheduleRun::converged_s(double position_m, double heading_rad) const {
+  std::optional<double> since;
+  for (const TrackedPose& p : poses) {
+    const bool within = p.position_error_m <= position_m && std::abs(p.heading_error_rad) <= heading_rad;
+    if (!within) {
+      since.reset();
+    } else if (!since) {
+      since = p.t_s;
+    }
+  }
+  return since;
+}
+
+FiringScheduleRun run_firing_schedule(const sim::Scenario& scenario, std::uint64_t seed, const std::string& estimator,
+                                      const std::map<std::string, double>& parameters, FiringSchedule schedule,
+                                      std::optional<Pose2> initial_pose) {
+  static const std::string kRobot = "robot";
+  OfflineStack stack(scenario, estimator, parameters, initial_pose);
+  sim::SimSource source(scenario, seed);
+  const std::vector<std::uint32_t> every = fire_all(BeaconMap(scenario.beacon_list()));
+  FiringScheduler scheduler(scenario.slot_period_ns, {every.begin(), every.end()});
+  FiringScheduleRun run;
+  std::vector<SourceEvent> events;
+  const StampNs end_ns = s_to_ns(scenario.duration_s);
+  // Slot by slot: the plan is made from the pose just before each firing (the first slot fires
+  // at first_slot_ns), as a localizer refreshing its plan faster than the slots, and the source
+  // fires by it as the gateway does (FiringScheduler: checked, judged by its age, and every
+  // beacon after unheard planned firings).
+  for (StampNs slot_ns = scenario.first_slot_ns;; slot_ns += scenario.slot_period_ns) {
+    if (schedule == FiringSchedule::kSelective) {
+      if (const std::optional<FiringPlan> plan = stack.localizer.firing_plan(kRobot)) {
+        scheduler.take(plan->beacon_ids, plan->stamp_ns, slot_ns);
+      }
+      source.set_firing_plan(scheduler.plan_at(slot_ns));
+    }
+    const StampNs until_ns = std::min(slot_ns + scenario.slot_period_ns - 1, end_ns);
+    events.clear();
+    source.advance(until_ns, events);
+    for (const Source::Firing& f : source.take_firings()) scheduler.on_firing(f.planned, f.heard);
+    for (const SourceEvent& e : events) {
+      if (e.kind == SourceEvent::Kind::kTof) ++run.tofs;
+      const std::optional<LocalizerOutput> out = stack.feed(kRobot, e);
+      if (!out || !e.has_truth) continue;
+      const Pose2 error = out->estimate.pose_map_base - e.truth_map_base;
+      const Eigen::Vector2d e_xy = error.head<2>();
+      const Eigen::LDLT<Eigen::Matrix2d> p_xy(out->estimate.covariance.topLeftCorner<2, 2>());
+      const double nees = p_xy.info() == Eigen::Success && p_xy.isPositive() ? e_xy.dot(p_xy.solve(e_xy))
+                                                                             : std::numeric_limits<double>::infinity();
+      run.poses.push_back({ns_to_s(e.stamp_ns), e_xy, e_xy.norm(), wrap_angle_rad(error.z()), nees,
+                           out->estimate.status});
+    }
+    if (until_ns == end_ns) break;
+  }
+  run.slots_fired = source.firing_counts().fired;
+  run.slots_heard = source.firing_counts().heard;
+  run.rejections.add_rejections(stack.localizer.counts(), "localizer.");
+  return run;
 }
 
 std::size_t AssociationTally::total() const {

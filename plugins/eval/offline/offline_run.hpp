@@ -47,8 +47,10 @@ struct AssociationTally {
 // Decoder and localizer cores wired as the participants wire them, knowing the scenario's map,
 // receivers, occupancy grid, start pose and range limits.
 struct OfflineStack {
+  // initial_pose: where an estimator placed by hand is placed; the scenario's start by default.
   explicit OfflineStack(const sim::Scenario& scenario, const std::string& estimator = "range_ekf",
-                        const std::map<std::string, double>& parameters = {});
+                        const std::map<std::string, double>& parameters = {},
+                        std::optional<Pose2> initial_pose = std::nullopt);
   // One simulated event in; the pose the localizer would publish, on odometry events.
   std::optional<LocalizerOutput> feed(const std::string& robot_id, const SourceEvent& e);
 
@@ -86,6 +88,33 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
                                       const std::string& estimator,
                                       const std::vector<std::string>& parameters, double settle_s = 0.0,
                                       const Delivery& delivery = {});
+
+// Seed 004 Sec. 3-4: a run whose beacons fire either all in turn (the scenario's firing order)
+// or selectively, the beacons the localizer plans for the robot (LocalizerCore::firing_plan)
+// before each slot, as the gateway honours the firing-plan topic. Every pose the localizer gives
+// on odometry, against the truth.
+enum class FiringSchedule { kAll, kSelective };
+struct TrackedPose {
+  double t_s = 0.0;
+  Eigen::Vector2d position_error_map_m = Eigen::Vector2d::Zero();  // estimate - truth, along x and y
+  double position_error_m = 0.0;
+  double heading_error_rad = 0.0;  // wrapped
+  double position_nees = 0.0;      // e^T P^-1 e over (x, y): 2 on average for an honest covariance
+  PoseStatus status = PoseStatus::kInitializing;
+};
+struct FiringScheduleRun {
+  std::vector<TrackedPose> poses;
+  std::uint64_t slots_fired = 0;  // slots in which a beacon fired
+  std::uint64_t slots_heard = 0;  // of those, slots some receiver heard
+  std::uint64_t tofs = 0;         // times of flight heard (a receiver's pulse from a firing)
+  RejectionCounter rejections;    // localizer.<reason>
+  // The first time from which every later pose is within position_m and heading_rad of the
+  // truth; nullopt when the run never settles so.
+  std::optional<double> converged_s(double position_m, double heading_rad) const;
+};
+FiringScheduleRun run_firing_schedule(const sim::Scenario& scenario, std::uint64_t seed, const std::string& estimator,
+                                      const std::map<std::string, double>& parameters, FiringSchedule schedule,
+                                      std::optional<Pose2> initial_pose = std::nullopt);
 
 struct AccuracyRow {
   std::string scenario;

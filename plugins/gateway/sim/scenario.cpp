@@ -42,6 +42,7 @@ BeaconList Scenario::beacon_list() const {
     const Pose2 in_group = between(frame->second, {b.position_map_m.x(), b.position_map_m.y(), 0.0});
     list.group_frame.push_back({b.id, b.group, {in_group.x(), in_group.y(), b.position_map_m.z()}});
   }
+  for (const Beacon& b : beacons) list.reach[b.id] = reach();
   return list;
 }
 

@@ -76,6 +76,8 @@ struct Scenario {
   double min_range_m = 0.0;                       // a receiver hears slant ranges in [min, max]
   double max_range_m = 5.0;
   double beam_half_angle_rad = M_PI / 2;         // cone around the beacon's downward axis
+  // Those three as every beacon's reach (the beacon map carries it: BeaconList::reach).
+  BeaconReach reach() const { return {min_range_m, max_range_m, beam_half_angle_rad}; }
   // Seed 003 Sec. 2: a beacon group (ULPS, group != 0) covers a circle of this radius on the
   // floor around its centre: a receiver hears the group's beacons within it and none outside
   // (on top of the range and beam limits above). None: each beacon's own limits alone.

@@ -1,5 +1,6 @@
 #include "sim_source.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -21,12 +22,7 @@ double pulse_arrival_s(const Trajectory& trajectory, const Eigen::Vector2d& rece
 }
 
 bool hears(const Scenario& s, const Eigen::Vector3d& beacon, const Eigen::Vector3d& receiver) {
-  const Eigen::Vector3d d = receiver - beacon;
-  const double range = d.norm();
-  if (range < s.min_range_m || range > s.max_range_m) return false;
-  if (range < 1e-9) return true;
-  const double cos_off_axis = -d.z() / range;  // angle to the beacon's downward axis
-  return cos_off_axis >= std::cos(s.beam_half_angle_rad) - 1e-12;
+  return s.reach().reaches(beacon, receiver);
 }
 
 // What a receiver without the beacons' radio message reports of a pulse (seed 002 Sec. 2): when it
@@ -50,15 +46,43 @@ SimSource::SimSource(Scenario scenario, std::uint64_t seed)
       next_scan_ns_(scenario_.laser ? scenario_.laser->period_ns : std::numeric_limits<StampNs>::max()),
       group_centres_map_m_(scenario_.group_centres_map_m()) {}
 
+void SimSource::set_firing_plan(std::optional<std::vector<std::uint32_t>> beacon_ids) {
+  if (beacon_ids) {
+    std::vector<std::uint32_t>& ids = *beacon_ids;
+    ids.erase(std::remove_if(ids.begin(), ids.end(),
+                             [this](std::uint32_t id) {
+                               return std::none_of(scenario_.beacons.begin(), scenario_.beacons.end(),
+                                                   [id](const Beacon& b) { return b.id == id; });
+                             }),
+              ids.end());
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    if (ids.empty()) beacon_ids.reset();
+  }
+  plan_ = std::move(beacon_ids);
+}
+
+std::uint32_t SimSource::next_beacon() {
+  if (!plan_) return scenario_.firing_order[slot_ % scenario_.firing_order.size()];
+  // The plan's next id after the last one fired, so that a plan refreshed every slot still
+  // fires each of its beacons in turn.
+  const auto after = last_fired_id_ ? std::upper_bound(plan_->begin(), plan_->end(), *last_fired_id_)
+                                    : plan_->begin();
+  return after == plan_->end() ? plan_->front() : *after;
+}
+
 void SimSource::fire(StampNs fire_ns) {
   if (scenario_.firing_order.empty()) return;
-  const std::uint32_t beacon_id = scenario_.firing_order[slot_ % scenario_.firing_order.size()];
+  const std::uint32_t beacon_id = next_beacon();
   ++slot_;
+  last_fired_id_ = beacon_id;
   const Beacon* beacon = nullptr;
   for (const auto& b : scenario_.beacons) {
     if (b.id == beacon_id) beacon = &b;
   }
   if (!beacon) return;
+  ++counts_.fired;
+  bool heard = false;
   const double c = speed_of_sound_mps(scenario_.temperature_c);
   const double fire_s = ns_to_s(fire_ns);
   const bool announces_id =
@@ -99,7 +123,11 @@ void SimSource::fire(StampNs fire_ns) {
     }
     if (!scenario_.radio_sync) e = as_pulse_arrival(std::move(e), scenario_.marked_beacon_id);
     pending_tofs_.push(e);
+    heard = true;
   }
+  if (heard) ++counts_.heard;
+  if (firings_.size() >= kMaxFiringLog) firings_.erase(firings_.begin(), firings_.begin() + kMaxFiringLog / 2);
+  firings_.push_back({fire_ns, beacon_id, plan_.has_value(), heard});
 }
 
 SourceEvent SimSource::odometry_at(StampNs stamp_ns) {

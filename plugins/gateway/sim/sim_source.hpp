@@ -31,9 +31,29 @@ class SimSource final : public Source {
     return scenario_.radio_sync ? BeaconInput::kRawTof : BeaconInput::kPulseArrivals;
   }
   const Scenario& scenario() const { return scenario_; }
+  // Selective activation (seed 004 Sec. 3): the beacons to fire from the next slot on, each in
+  // turn in id order (after the last one fired), instead of the scenario's firing order; nullopt
+  // returns to the firing order. Ids the scenario lacks are never fired; an empty plan is the
+  // firing order (a robot is never left blind).
+  // Only where each pulse names its beacon (radio, identified): beacons heard without an id are
+  // named by their place in the firing order (seed 002's cycle), which a plan would break.
+  bool honours_firing_plan() const override { return scenario_.radio_sync && scenario_.identified; }
+  StampNs slot_period_ns() const override { return scenario_.slot_period_ns; }
+  void set_firing_plan(std::optional<std::vector<std::uint32_t>> beacon_ids) override;
+  std::vector<Firing> take_firings() override {
+    std::vector<Firing> out;
+    out.swap(firings_);
+    return out;
+  }
+  struct FiringCounts {
+    std::uint64_t fired = 0;  // slots in which a beacon fired
+    std::uint64_t heard = 0;  // of those, slots in which some receiver heard it
+  };
+  FiringCounts firing_counts() const { return counts_; }
 
  private:
   void fire(StampNs fire_ns);
+  std::uint32_t next_beacon();
   SourceEvent odometry_at(StampNs stamp_ns);
   SourceEvent scan_at(StampNs stamp_ns);
   double normal() { return unit_normal_(rng_); }
@@ -53,6 +73,12 @@ class SimSource final : public Source {
   StampNs next_fire_ns_;
   StampNs next_scan_ns_;
   std::uint64_t slot_ = 0;
+  std::optional<std::vector<std::uint32_t>> plan_;
+  std::optional<std::uint32_t> last_fired_id_;
+  FiringCounts counts_;
+  // Firings not yet taken, at most kMaxFiringLog (a caller that never takes them keeps the newest).
+  static constexpr std::size_t kMaxFiringLog = 4096;
+  std::vector<Firing> firings_;
   std::uint64_t tof_sequence_ = 0;
   std::priority_queue<SourceEvent, std::vector<SourceEvent>, Later> pending_tofs_;
   std::map<std::uint32_t, Eigen::Vector2d> group_centres_map_m_;  // for group_coverage_radius_m

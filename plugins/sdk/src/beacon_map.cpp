@@ -25,6 +25,10 @@ const char* to_string(BeaconMapProblem problem) {
       return "local_without_group";
     case BeaconMapProblem::kGroupBothKinds:
       return "group_both_kinds";
+    case BeaconMapProblem::kBadReach:
+      return "bad_reach";
+    case BeaconMapProblem::kReachWithoutBeacon:
+      return "reach_without_beacon";
   }
   return "unknown";
 }
@@ -67,6 +71,10 @@ BeaconMapCheck check_beacons(const BeaconList& beacons) {
     if (b.group == 0) return {BeaconMapProblem::kLocalWithoutGroup, b.id};
     if (global_groups.count(b.group)) return {BeaconMapProblem::kGroupBothKinds, b.id};
   }
+  for (const auto& [id, reach] : beacons.reach) {
+    if (!ids.count(id)) return {BeaconMapProblem::kReachWithoutBeacon, id};
+    if (!reach.valid()) return {BeaconMapProblem::kBadReach, id};
+  }
   return {};
 }
 
@@ -75,6 +83,9 @@ BeaconMap::BeaconMap(const BeaconList& beacons) {
   if (!check.ok()) throw InvalidBeaconMap(check);
   for (const auto& b : beacons.map_frame) beacons_[b.id] = b;
   for (const auto& b : beacons.group_frame) local_[b.id] = b;
+  for (const auto& [id, reach] : beacons.reach) {
+    if (reach.known()) reach_[id] = reach;  // an unknown reach is the default: not held
+  }
 }
 
 std::optional<BeaconMap> BeaconMap::from(const BeaconList& beacons, BeaconMapCheck* check) {
@@ -106,7 +117,7 @@ bool BeaconMap::operator==(const BeaconMap& other) const {
       return false;
     }
   }
-  return true;
+  return reach_ == other.reach_;
 }
 
 }  // namespace beaconloc

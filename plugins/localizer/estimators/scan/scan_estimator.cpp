@@ -83,6 +83,7 @@ void ScanEstimator::set_beacon_map(const BeaconMap& map) {
   last_grulps_correction_ns_.reset();
   back_in_grulps_since_ns_.reset();
   calibrated_since_grulps_ = 0;
+  calibrated_correction_m2_.setZero();  // the old map's calibrated groups no longer correct the pose
   waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(beacons_for_a_fix(params_.geometry)), {}};
 }
 
@@ -121,9 +122,12 @@ Eigen::Matrix2d ScanEstimator::calibrated_group_covariance(std::uint32_t beacon_
   const LocalBeacon* local = map().find_local(beacon_id);
   Eigen::Matrix2d largest = Eigen::Matrix2d::Zero();
   if (!local) return largest;
-  for (const auto& [id, b] : calibrated_) {
-    const LocalBeacon* other = map().find_local(id);
-    if (other && other->group == local->group && b.covariance_m2.trace() > largest.trace()) largest = b.covariance_m2;
+  // The group's calibration as it stands (a recalibrated group's beacons only).
+  for (const GroupCalibration& g : calibration_.groups) {
+    if (g.group != local->group) continue;
+    for (const CalibratedBeacon& b : g.beacons) {
+      if (b.covariance_m2.trace() > largest.trace()) largest = b.covariance_m2;
+    }
   }
   return largest;
 }

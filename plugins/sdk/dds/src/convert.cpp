@@ -139,14 +139,22 @@ BeaconList from_msg(const msg::BeaconMap& m) {
         beacons.map_frame.push_back({b.id(), position_m, b.group()});
         break;
     }
+    // All zero: not known (the default). Anything else is the beacon's reach, checked with the
+    // map (check_beacons: bad_reach), not repaired here.
+    const BeaconReach reach{b.min_range_m(), b.max_range_m(), b.beam_half_angle_rad()};
+    if (reach != BeaconReach{}) beacons.reach[b.id()] = reach;
   }
   return beacons;
 }
 
 namespace {
 
-msg::Beacon beacon_msg(std::uint32_t id, const Eigen::Vector3d& position_m, std::uint32_t group, msg::BeaconFrame frame) {
+msg::Beacon beacon_msg(std::uint32_t id, const Eigen::Vector3d& position_m, std::uint32_t group, msg::BeaconFrame frame,
+                       const BeaconReach& reach) {
   msg::Beacon mb;
+  mb.min_range_m(reach.min_range_m);
+  mb.max_range_m(reach.max_range_m);
+  mb.beam_half_angle_rad(reach.beam_half_angle_rad);
   mb.id(id);
   mb.x_m(position_m.x());
   mb.y_m(position_m.y());
@@ -162,10 +170,10 @@ msg::BeaconMap to_msg(const BeaconMap& map, const std::string& frame_id) {
   msg::BeaconMap m;
   m.frame_id(frame_id);
   for (const Beacon& b : map.beacons()) {
-    m.beacons().push_back(beacon_msg(b.id, b.position_map_m, b.group, msg::BEACON_FRAME_MAP));
+    m.beacons().push_back(beacon_msg(b.id, b.position_map_m, b.group, msg::BEACON_FRAME_MAP, map.reach_of(b.id)));
   }
   for (const LocalBeacon& b : map.local_beacons()) {
-    m.beacons().push_back(beacon_msg(b.id, b.position_group_m, b.group, msg::BEACON_FRAME_GROUP));
+    m.beacons().push_back(beacon_msg(b.id, b.position_group_m, b.group, msg::BEACON_FRAME_GROUP, map.reach_of(b.id)));
   }
   return m;
 }

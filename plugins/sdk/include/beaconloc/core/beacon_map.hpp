@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "beaconloc/core/beacon_reach.hpp"
 #include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/measurements.hpp"
 #include "beaconloc/core/rejection_counter.hpp"
@@ -49,6 +50,8 @@ struct BeaconList {
       : map_frame(std::move(map_frame_beacons)), group_frame(std::move(group_frame_beacons)) {}
   std::vector<Beacon> map_frame;
   std::vector<LocalBeacon> group_frame;
+  // Where each beacon is heard (seed 004), by id; a beacon not listed has no known reach.
+  std::map<std::uint32_t, BeaconReach> reach;
 };
 
 // More beacons than any site has (a slot every 200 ms would take 13 min to fire them all): a
@@ -65,6 +68,8 @@ enum class BeaconMapProblem {
   kPositionOutOfRange,  // a coordinate beyond kMaxMapCoordinateM
   kLocalWithoutGroup,   // a locally referenced beacon in group 0: no frame to be local to
   kGroupBothKinds,      // a group with beacons in the map frame and beacons in its own frame
+  kBadReach,            // a reach that is not BeaconReach::valid() (NaN, min >= max, angle beyond pi)
+  kReachWithoutBeacon,  // a reach given for an id the map does not hold
 };
 // Stable snake_case names (Diagnostics reasons: beacon_map.<name>).
 const char* to_string(BeaconMapProblem problem);
@@ -125,8 +130,17 @@ class BeaconMap {
     for (const auto& [id, b] : beacons_) out.push_back(b);
     return out;
   }
-  BeaconList list() const { return {beacons(), local_beacons()}; }
-  // Same beacons at the same positions in the same groups and frames (a gateway that restarts
+  // Where a beacon is heard; not known() when the map does not say.
+  BeaconReach reach_of(std::uint32_t id) const {
+    auto it = reach_.find(id);
+    return it == reach_.end() ? BeaconReach{} : it->second;
+  }
+  BeaconList list() const {
+    BeaconList out{beacons(), local_beacons()};
+    out.reach = reach_;
+    return out;
+  }
+  // Same beacons at the same positions in the same groups and frames, with the same reach (a gateway that restarts
   // publishes the map again: that is no new map).
   bool operator==(const BeaconMap& other) const;
   bool operator!=(const BeaconMap& other) const { return !(*this == other); }
@@ -134,6 +148,7 @@ class BeaconMap {
  private:
   std::map<std::uint32_t, Beacon> beacons_;     // ordered: deterministic iteration
   std::map<std::uint32_t, LocalBeacon> local_;  // locally referenced, by id
+  std::map<std::uint32_t, BeaconReach> reach_;   // known reach, by id
 };
 
 // How every participant takes a map from the bus: the map, or nullopt with the refusal counted

@@ -24,6 +24,7 @@ inline constexpr TopicSpec kInitialPoseTopic{"beaconloc/initial_pose", "initial_
 inline constexpr TopicSpec kBeaconMapTopic{"beaconloc/beacon_map", "beacon_map.writer", "beacon_map.reader"};
 inline constexpr TopicSpec kBeaconCalibrationTopic{"beaconloc/beacon_calibration", "beacon_calibration.writer",
                                                    "beacon_calibration.reader"};
+inline constexpr TopicSpec kFiringPlanTopic{"beaconloc/firing_plan", "firing_plan.writer", "firing_plan.reader"};
 inline constexpr TopicSpec kDiagnosticsTopic{"beaconloc/diagnostics", "diagnostics.writer",
                                              "diagnostics.reader"};
 
