@@ -149,11 +149,13 @@ TEST(TwoReceiverEkfOnSeed004, SelectiveActivationConvergesFasterAndWastesFewerSl
   }
   for (int k = 0; k < 2; ++k) {
     std::printf(
-        "seed004 %-9s: %llu slots fired, %.1f %% unheard, %llu times of flight; converged (%.2f m, %.2f rad) "
-        "median %.2f s, worst %.2f s\n",
+        "seed004 %-9s: %llu slots fired, %llu (%.1f %%) unheard, %llu times of flight, %.3f slots per time of "
+        "flight; converged (%.2f m, %.2f rad) median %.2f s, worst %.2f s\n",
         k == 0 ? "all" : "selective", static_cast<unsigned long long>(fired[k]),
+        static_cast<unsigned long long>(fired[k] - heard[k]),
         100.0 * static_cast<double>(fired[k] - heard[k]) / static_cast<double>(fired[k]),
-        static_cast<unsigned long long>(tofs[k]), kConvergedPositionM, kConvergedHeadingRad,
+        static_cast<unsigned long long>(tofs[k]), static_cast<double>(fired[k]) / static_cast<double>(tofs[k]),
+        kConvergedPositionM, kConvergedHeadingRad,
         percentile(converged[k], 0.5), percentile(converged[k], 1.0));
   }
   EXPECT_LT(percentile(converged[1], 0.5), percentile(converged[0], 0.5));
