@@ -199,12 +199,21 @@ void print_pose_line(double t_s, const PoseRecorder& recorder) {
 PoseBoundResult bound_of_run(const PipelineOptions& o, const LoadedSource& source, const std::vector<RecordedPose>& poses,
                              const TruthTrack& truth, const EvaluationOptions& eval) {
   const sim::Scenario& scenario = *source.scenario;
-  const bool laser_fused =
-      LocalizerCore(o.localizer.estimator,
-                    estimator_config_for(scenario, parse_estimator_parameters(o.localizer.parameters, "parameter")))
-          .uses_laser();
+  // What the estimator that ran is, from the settings it ran with (as run_in_one_process builds
+  // them; no map file is written again).
+  BoundedEstimator estimator;
+  estimator.poses_corrected = true;  // PoseRecorder keeps the newest pose per stamp
+  try {
+    EstimatorConfig config = with_scenario_defaults(o.localizer, source, "").config(scenario.receivers);
+    if (!config.occupancy_grid && scenario.map) config.occupancy_grid = std::make_shared<const OccupancyGrid>(*scenario.map);
+    const LocalizerCore probe(o.localizer.estimator, std::move(config));
+    estimator.laser_fused = probe.uses_laser();
+    estimator.localizes_from_beacons = probe.localizes_from_beacons();
+  } catch (const std::exception& e) {
+    return {std::nullopt, std::string("the estimator could not be asked what it fuses: ") + e.what(), false};
+  }
   if (o.localizer.selective_activation()) {
-    return {std::nullopt, "selective firing: the bound follows the scenario's own firing order", laser_fused};
+    return {std::nullopt, "selective firing: the bound follows the scenario's own firing order", estimator.laser_fused};
   }
   const double duration_s = std::max(o.gateway.duration_s, scenario.duration_s);
   const std::vector<SourceEvent> events = simulate(scenario, source.seed, duration_s);
@@ -221,7 +230,7 @@ PoseBoundResult bound_of_run(const PipelineOptions& o, const LoadedSource& sourc
   for (const RecordedPose& p : poses) {
     if (p.row.estimate.stamp_ns >= eval.score_from_ns) scored_ns.push_back(p.row.estimate.stamp_ns - offset_ns);
   }
-  return pose_bound_of_run(scenario, events, scored_ns, laser_fused);
+  return pose_bound_of_run(scenario, events, scored_ns, estimator);
 }
 
 // Scores and writes the outputs shared by both modes.
@@ -239,7 +248,6 @@ PipelineResult finish(const PipelineOptions& o, const LoadedSource& source, cons
   r.metrics = s.metrics;
   r.truth_samples = truth.size();
   r.diagnostics = diagnostics;
-  if (source.scenario) r.bound = bound_of_run(o, source, poses, truth, eval);
   if (!o.out_dir.empty()) {
     const auto rows = rows_of(poses);
     write_estimates_csv(o.out_dir + "/estimate.csv", rows);
@@ -252,6 +260,8 @@ PipelineResult finish(const PipelineOptions& o, const LoadedSource& source, cons
     if (!state.empty()) write_estimator_state_csv(o.out_dir + "/estimator_state.csv", state);
   }
   r.estimator_state_rows = state.size();
+  // After the files: whatever the bound meets, the run's outputs are written.
+  if (source.scenario) r.bound = bound_of_run(o, source, poses, truth, eval);
   return r;
 }
 

@@ -12,9 +12,11 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <stdexcept>
 
 #include "beaconloc/core/models/diff_drive_motion.hpp"
+#include "beaconloc/core/models/range_model.hpp"
 #include "offline_run.hpp"
 #include "pose_bound.hpp"
 #include "sim/scenario.hpp"
@@ -125,7 +127,7 @@ TEST(PoseBound, CausesOfErrorItDoesNotModelAreRefusedWithTheReason) {
     ASSERT_TRUE(why) << reason;
     EXPECT_NE(why->find(reason), std::string::npos) << *why;
     EXPECT_THROW(pose_bound_trace(s, simulate(s, 1, s.duration_s)), std::invalid_argument);
-    const PoseBoundResult r = pose_bound_of_run(s, {}, {1}, false);
+    const PoseBoundResult r = pose_bound_of_run(s, {}, {1}, {false, true, false});
     EXPECT_FALSE(r.rms);
     EXPECT_EQ(r.unavailable, *why);
   };
@@ -142,14 +144,71 @@ TEST(PoseBound, CausesOfErrorItDoesNotModelAreRefusedWithTheReason) {
 TEST(PoseBound, ItsLineForRunGivesTheRatiosOrWhyNot) {
   PoseBoundResult r;
   r.rms = PoseBoundRms{0.01, 0.5, 100};
-  EXPECT_NE(format_pose_bound(r, 0.012, 0.6).find("ours 1.20x and 1.20x"), std::string::npos)
-      << format_pose_bound(r, 0.012, 0.6);
+  Metrics m;
+  m.samples = 100;
+  m.position_rms_m = 0.012;
+  m.heading_rms_deg = 0.6;
+  EXPECT_NE(format_pose_bound(r, m).find("ours 1.20x and 1.20x"), std::string::npos) << format_pose_bound(r, m);
+  m.samples = 99;  // the bound over other poses than those scored: no ratio
+  EXPECT_NE(format_pose_bound(r, m).find("ours n/a (the bound covers other poses"), std::string::npos)
+      << format_pose_bound(r, m);
+  m.samples = 100;
+  r.rms = PoseBoundRms{0.0, 0.0, 100};  // a noise-free scenario: no ratio, no inf
+  EXPECT_NE(format_pose_bound(r, m).find("ours n/a (a zero bound"), std::string::npos) << format_pose_bound(r, m);
+  EXPECT_EQ(format_pose_bound(r, m).find("inf"), std::string::npos);
+  r.rms = PoseBoundRms{0.01, 0.5, 100};
   r.laser_fused = true;
-  EXPECT_EQ(format_pose_bound(r, 0.012, 0.6).find("ours"), std::string::npos);
-  EXPECT_NE(format_pose_bound(r, 0.012, 0.6).find("laser"), std::string::npos);
+  EXPECT_EQ(format_pose_bound(r, m).find("ours"), std::string::npos);
+  EXPECT_NE(format_pose_bound(r, m).find("laser"), std::string::npos);
   PoseBoundResult none;
   none.unavailable = "because";
-  EXPECT_NE(format_pose_bound(none, 0.012, 0.6).find("n/a (because)"), std::string::npos);
+  EXPECT_NE(format_pose_bound(none, m).find("n/a (because)"), std::string::npos);
+}
+
+// A step the recursion refuses (no noise at all: a zero prior and exact ranges leave a zero
+// innovation) is a reason, not an exception out of `accuracy` or `run`.
+TEST(PoseBound, ARefusedStepIsAReasonNotACrash) {
+  sim::Scenario s = sim::default_scenario();
+  s.duration_s = 2.0;
+  s.range_sigma_m = 0.0;
+  s.odometry_k_v_m = 0.0;
+  const std::vector<SourceEvent> events = simulate(s, 1, s.duration_s);
+  EXPECT_THROW(pose_bound_trace(s, events), std::runtime_error);
+  const PoseBoundResult r = pose_bound_of_run(s, events, {s_to_ns(1.0)}, {false, false, false});
+  EXPECT_FALSE(r.rms);
+  EXPECT_NE(r.unavailable.find("was refused"), std::string::npos) << r.unavailable;
+}
+
+// The range half of the noise the bound takes is the simulator's: a decoded range less the
+// true distance from the beacon to the receiver at the pulse's arrival has range_variance_m2
+// (range and arrival-time noise together).
+TEST(PoseBound, RangeNoiseIsWhatTheSimulatorDraws) {
+  sim::Scenario s = sim::default_scenario();
+  s.duration_s = 60.0;
+  s.tof_sigma_s = 3e-5;  // ~1 cm of arrival-time noise beside the 1 cm range noise
+  TofDecoder decoder = scenario_decoder(s);
+  std::map<std::uint32_t, Eigen::Vector3d> beacons;
+  for (const Beacon& b : s.beacons) beacons[b.id] = b.position_map_m;
+  double sum = 0.0, sum_sq = 0.0;
+  std::size_t n = 0;
+  for (const SourceEvent& e : simulate(s, 1, s.duration_s)) {
+    if (e.kind != SourceEvent::Kind::kTof) continue;
+    const auto out = decoder.decode("robot", e.tof);
+    ASSERT_TRUE(out.range);
+    const double distance = predict_range(s.trajectory.pose_at(ns_to_s(e.stamp_ns)),
+                                          s.receivers.receivers_base_m[e.tof.receiver_id],
+                                          s.receivers.receiver_height_m, beacons.at(e.true_beacon_id))
+                                .range_m;
+    const double error = out.range->range.range_m - distance;
+    sum += error;
+    sum_sq += error * error;
+    ++n;
+  }
+  ASSERT_GT(n, 500u);
+  const double mean = sum / static_cast<double>(n);
+  const double variance = sum_sq / static_cast<double>(n) - mean * mean;
+  EXPECT_NEAR(variance / sim::range_variance_m2(s), 1.0, 0.15) << n << " ranges";  // sqrt(2 / n) < 6 %
+  EXPECT_LT(std::abs(mean), 3.0 * std::sqrt(sim::range_variance_m2(s) / static_cast<double>(n)));
 }
 
 }  // namespace

@@ -220,7 +220,8 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
   for (const EstimateRow& row : rows) {
     if (row.estimate.stamp_ns >= options.score_from_ns) scored_ns.push_back(row.estimate.stamp_ns);
   }
-  result.bound = pose_bound_of_run(scenario, events, scored_ns, stack.localizer.uses_laser());
+  result.bound = pose_bound_of_run(scenario, events, scored_ns,
+                                   {stack.localizer.uses_laser(), stack.localizer.localizes_from_beacons(), false});
   return result;
 }
 
@@ -284,7 +285,9 @@ std::string bound_table_markdown(const std::vector<AccuracyRow>& rows) {
       continue;
     }
     std::vector<double> ep, bound_p, ephi, bound_phi;
+    bool same_poses = true;
     for (std::size_t i = 0; i < row.runs.size(); ++i) {
+      same_poses = same_poses && row.bounds[i].samples == row.runs[i].samples;
       ep.push_back(row.runs[i].position_rms_m);
       bound_p.push_back(row.bounds[i].position_m);
       if (row.runs[i].heading_rms_deg) {
@@ -292,12 +295,7 @@ std::string bound_table_markdown(const std::vector<AccuracyRow>& rows) {
         bound_phi.push_back(row.bounds[i].heading_deg);
       }
     }
-    const auto ratio = [&row](double ours, double bound) {
-      char r[64];
-      if (row.laser_fused) return std::string("n/a (fuses the laser, not in the bound)");
-      std::snprintf(r, sizeof r, "%.2f", ours / bound);
-      return std::string(r);
-    };
+    const auto ratio = [&](double ours, double bound) { return bound_ratio(row.laser_fused, same_poses, ours, bound); };
     std::snprintf(text, sizeof text, "%.4f | %.4f | ", quadratic_mean(ep), quadratic_mean(bound_p));
     out << text << ratio(quadratic_mean(ep), quadratic_mean(bound_p)) << " | ";
     if (ephi.empty()) {
