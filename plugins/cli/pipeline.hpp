@@ -11,6 +11,7 @@
 #include "bridge_participant.hpp"
 #include "evaluation.hpp"
 #include "gateway_participant.hpp"
+#include "pose_bound.hpp"
 #include "replay/replay_source.hpp"
 #include "sim/scenario.hpp"
 #include "tof_decoder.hpp"
@@ -78,6 +79,7 @@ struct PipelineResult {
   std::size_t truth_samples = 0;  // 0: the source has no ground truth (a replay without gt.csv)
   std::string diagnostics;        // each participant's counts, one line each
   std::size_t estimator_state_rows = 0;  // written to estimator_state.csv (estimators with such state)
+  std::optional<PoseBoundResult> bound;  // simulated sources: the posterior Cramer-Rao bound (docs/bound.md)
 };
 
 // Runs to the end of the source (or the duration), then evaluates. With out_dir, writes

@@ -13,6 +13,7 @@ LocalizerCore::LocalizerCore(std::string estimator_name, EstimatorConfig config,
   // Fail at start, not at the first sample, when the name or the configuration is wrong.
   const auto probe = EstimatorRegistry::instance().create(estimator_name_, config_);
   uses_laser_ = probe->uses_laser();
+  localizes_from_beacons_ = probe->localizes_from_beacons();
   beacon_input_ = probe->beacon_input();
   uses_calibration_ = probe->uses_calibration();
 }

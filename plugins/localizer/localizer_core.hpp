@@ -85,6 +85,9 @@ class LocalizerCore {
   std::optional<LocalizerOutput> on_range(const std::string& robot_id, const RangeMeasurement& range);
   // Laser scans reach estimators that use them (uses_laser()); others never see one.
   bool uses_laser() const { return uses_laser_; }
+  // Whether the estimator finds itself from the beacons (Estimator::localizes_from_beacons), not
+  // told where it starts.
+  bool localizes_from_beacons() const { return localizes_from_beacons_; }
   std::optional<LocalizerOutput> on_laser(const std::string& robot_id, const LaserScanSample& scan);
   // Each estimator hears the beacons one way (Estimator::beacon_input): decoded ranges, raw times
   // of flight, or pulse arrivals (seed 002); the participant subscribes to that topic alone, and
@@ -181,6 +184,7 @@ class LocalizerCore {
   EstimatorConfig config_;
   std::string robot_filter_;
   bool uses_laser_ = false;
+  bool localizes_from_beacons_ = true;
   BeaconInput beacon_input_ = BeaconInput::kRanges;
   BeaconMap map_;
   std::map<std::string, Robot> robots_;

@@ -109,6 +109,7 @@ TEST_F(Run, ReplaysTheTucFixture) {
   EXPECT_GT(json_number(metrics, "samples"), 150);
   EXPECT_LT(json_number(metrics, "position_rms_m"), 0.5);
   EXPECT_NE(metrics.find("\"heading_rms_deg\": null"), std::string::npos);  // the recording has no heading
+  EXPECT_EQ(out.find("Cramer-Rao"), std::string::npos) << out;  // a recording has no noise model to bound
 }
 
 // A replay without gt.csv (optional, docs/replay-format.md) is localized and its poses written,
@@ -164,6 +165,12 @@ TEST_F(Run, OneProcessPerParticipant) {
   EXPECT_GT(json_number(metrics, "samples"), 800) << out;
   EXPECT_LT(json_number(metrics, "position_rms_m"), 0.15) << out;
   EXPECT_TRUE(std::filesystem::exists(dir_ + "/localizer.log"));
+  // The bound along the simulated path beside ours (docs/bound.md), over the poses scored.
+  EXPECT_NE(out.find("posterior Cramer-Rao bound over " + std::to_string(static_cast<long>(json_number(metrics, "samples"))) +
+                     " poses: position "),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("; ours "), std::string::npos) << out;
 }
 
 // Seed 001 through DDS, one process per participant: laser scans and anonymous beacon ranges
@@ -177,6 +184,7 @@ TEST_F(Run, UkfFusesLaserAndAnonymousBeaconsAcrossProcesses) {
   const std::string metrics = read(dir_ + "/metrics.json");
   EXPECT_GT(json_number(metrics, "samples"), 700) << out;           // 20 s of 22 ms odometry steps: ~900
   EXPECT_LT(json_number(metrics, "position_rms_m"), 0.101) << out;  // the paper's Table 6, fusion
+  EXPECT_NE(out.find("(odometry and ranges; the laser fused here is not in it)"), std::string::npos) << out;
   EXPECT_TRUE(std::filesystem::exists(dir_ + "/map.yaml"));
   EXPECT_TRUE(std::filesystem::exists(dir_ + "/map.pgm"));
   // Every beacon range decoded (the scenario's 15 m limit reached the decoder), none refused; the
@@ -194,6 +202,7 @@ TEST_F(Run, LocallyReferencedBeaconsCrossTheBusInTheirFramesAndAreNotUsedUncalib
                                       kSource + "/examples/scenarios/seed003_scan.yaml", "--out", dir_});
   ASSERT_EQ(code, 0) << out;
   EXPECT_NE(out.find("range.uncalibrated_beacon"), std::string::npos) << out;
+  EXPECT_NE(out.find("posterior Cramer-Rao bound: n/a (locally referenced beacon groups"), std::string::npos) << out;
   EXPECT_EQ(out.find("unknown_beacon"), std::string::npos) << out;
   const std::string beacons = read(dir_ + "/beacons.csv");
   EXPECT_NE(beacons.find(",3,group\n"), std::string::npos) << beacons;

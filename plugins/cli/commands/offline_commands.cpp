@@ -71,6 +71,9 @@ class AccuracyCommand : public Command {
     app_->add_option("--fault", faults_,
                      "also score the scenarios with this fault (repeatable, all at once): beacon_dies=ID@T, "
                      "tof_outage=FROM:TO, echoes=P; the clean row comes first");
+    app_->add_flag("--identified", identified_,
+                   "every range carries its beacon's id, also in a scenario whose beacons are anonymous (the "
+                   "association given, as the bound assumes: for estimators that need it, such as range_ekf)");
     app_->add_option("--delay-ms", delay_ms_,
                      "also score with every TOF and scan delivered late by a uniform random 0..D ms "
                      "(odometry on time); the in-order row comes first")
@@ -89,9 +92,12 @@ class AccuracyCommand : public Command {
         }
       }
     }
-    const std::string table = table_ == "distance" ? distance_table_markdown(rows)
-                              : table_ == "path"   ? path_table_markdown(rows)
-                                                   : accuracy_table_markdown(rows);
+    // Each table, then the same runs beside the posterior Cramer-Rao bound (docs/bound.md).
+    const std::string table = (table_ == "distance" ? distance_table_markdown(rows)
+                               : table_ == "path"   ? path_table_markdown(rows)
+                                                    : accuracy_table_markdown(rows)) +
+                              "\nposterior Cramer-Rao bound along the true path (docs/bound.md):\n\n" +
+                              bound_table_markdown(rows);
     // The file first: a reader of stdout that leaves early (`| head`) ends the command (SIGPIPE).
     if (!out_file_.empty()) {
       std::ofstream out(out_file_);
@@ -128,6 +134,10 @@ class AccuracyCommand : public Command {
   std::vector<Variant> variants_of(const std::string& file, bool compared) const {
     sim::Scenario clean = sim::load_scenario_file(file);
     if (odometry_k_v_m_) clean.odometry_k_v_m = *odometry_k_v_m_;
+    if (identified_ && !clean.identified) {
+      clean.identified = true;
+      clean.name += " (identified)";
+    }
     std::vector<Variant> variants{{clean.name, clean, {}}};
     if (!compared) return variants;
     Variant v{clean.name, clean, {}};
@@ -146,7 +156,7 @@ class AccuracyCommand : public Command {
   }
   // Every seed of one variant and estimator; a run that gave nothing is no 0 m: a failure.
   AccuracyRow score(const Variant& variant, const std::string& estimator, std::vector<std::string>& failed_runs) const {
-    AccuracyRow row{variant.label, estimator, {}, {}, {}};
+    AccuracyRow row{variant.label, estimator, {}, {}, {}, {}, {}, false};
     for (int k = 0; k < seeds_; ++k) {
       const std::uint64_t seed = first_seed_ + static_cast<std::uint64_t>(k);
       const OfflineRunResult r =
@@ -157,6 +167,9 @@ class AccuracyCommand : public Command {
         continue;
       }
       row.runs.push_back(r.metrics);
+      if (r.bound.rms) row.bounds.push_back(*r.bound.rms);
+      if (!r.bound.unavailable.empty()) row.bound_unavailable = r.bound.unavailable;
+      row.laser_fused = r.bound.laser_fused;
       if (r.associations.total()) row.associations.push_back(r.associations);
       for (const auto& [reason, n] : r.rejections.rejected_by_reason()) row.rejections[reason] += n;
     }
@@ -171,6 +184,7 @@ class AccuracyCommand : public Command {
   std::string table_ = "pose";
   std::string out_file_;
   double delay_ms_ = 0.0;
+  bool identified_ = false;
 };
 
 }  // namespace

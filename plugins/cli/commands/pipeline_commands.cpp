@@ -33,6 +33,9 @@ class PipelineCommand : public Command {
     const bool has_truth = r.truth_samples > 0;
     std::printf("poses: %zu at %.1f Hz; %s\n", r.poses, r.pose_rate_hz,
                 has_truth ? format_metrics(r.metrics).c_str() : "no ground truth: not scored");
+    if (r.bound && r.metrics.samples) {
+      std::cout << format_pose_bound(*r.bound, r.metrics) << '\n';
+    }
     if (!o.out_dir.empty()) {
       std::cout << "wrote " << o.out_dir << "/{truth,estimate,beacons}.csv, metrics.json, trajectory.svg, error.svg"
                 << (r.estimator_state_rows ? ", estimator_state.csv" : "") << '\n';

@@ -15,10 +15,8 @@
 
 namespace beaconloc {
 
-namespace {
-
-EstimatorConfig config_for(const sim::Scenario& scenario, const std::map<std::string, double>& parameters,
-                           const std::optional<Pose2>& initial_pose) {
+EstimatorConfig estimator_config_for(const sim::Scenario& scenario, const std::map<std::string, double>& parameters,
+                                     const std::optional<Pose2>& initial_pose) {
   EstimatorConfig config;
   config.receivers = scenario.receivers;
   config.parameters = parameters;
@@ -27,8 +25,6 @@ EstimatorConfig config_for(const sim::Scenario& scenario, const std::map<std::st
   config.initial_pose = initial_pose ? *initial_pose : scenario.trajectory.pose_at(0.0);
   return config;
 }
-
-}  // namespace
 
 TofDecoderConfig decoder_config_for(const sim::Scenario& scenario) {
   TofDecoderConfig c;
@@ -53,7 +49,7 @@ std::vector<SourceEvent> simulate(const sim::Scenario& scenario, std::uint64_t s
 
 OfflineStack::OfflineStack(const sim::Scenario& scenario, const std::string& estimator,
                            const std::map<std::string, double>& parameters, std::optional<Pose2> initial_pose)
-    : localizer(estimator, config_for(scenario, parameters, initial_pose)), decoder(decoder_config_for(scenario)) {
+    : localizer(estimator, estimator_config_for(scenario, parameters, initial_pose)), decoder(decoder_config_for(scenario)) {
   localizer.set_beacon_map(BeaconMap(scenario.beacon_list()));
   decoder.set_beacon_map(BeaconMap(scenario.beacon_list()));
 }
@@ -204,7 +200,8 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
   OfflineStack stack(scenario, estimator, parse_estimator_parameters(parameters, "parameter"));
   TruthTrack truth;
   std::vector<EstimateRow> rows;
-  for (const auto& e : deliver(simulate(scenario, seed, scenario.duration_s), delivery, seed)) {
+  const std::vector<SourceEvent> events = simulate(scenario, seed, scenario.duration_s);
+  for (const auto& e : deliver(events, delivery, seed)) {
     if (e.kind == SourceEvent::Kind::kOdometry) truth.add(e.stamp_ns, e.truth_map_base);
     if (auto pose = stack.feed("robot", e)) rows.push_back({"robot", pose->estimate, estimator});
   }
@@ -219,6 +216,12 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
     options.score_from_ns = std::max(rows.front().estimate.stamp_ns + s_to_ns(settle_s), s_to_ns(scenario.score_from_s));
   }
   result.metrics = evaluate(truth, rows, options);
+  std::vector<StampNs> scored_ns;
+  for (const EstimateRow& row : rows) {
+    if (row.estimate.stamp_ns >= options.score_from_ns) scored_ns.push_back(row.estimate.stamp_ns);
+  }
+  result.bound = pose_bound_of_run(scenario, events, scored_ns,
+                                   {stack.localizer.uses_laser(), stack.localizer.localizes_from_beacons(), false});
   return result;
 }
 
@@ -254,6 +257,53 @@ std::string accuracy_table_markdown(const std::vector<AccuracyRow>& rows) {
     out << "| " << row.scenario << " | " << row.estimator << " | " << row.runs.size() << " | "
         << mean_and_spread(ep, 3) << " | " << mean_and_spread(ephi, 2) << " | " << mean_and_spread(es, 3)
         << " | " << mean_and_spread(nees, 2) << " |\n";
+  }
+  return out.str();
+}
+
+namespace {
+
+double quadratic_mean(const std::vector<double>& values) {
+  double sum = 0.0;
+  for (double v : values) sum += v * v;
+  return std::sqrt(sum / static_cast<double>(values.size()));
+}
+
+}  // namespace
+
+std::string bound_table_markdown(const std::vector<AccuracyRow>& rows) {
+  std::ostringstream out;
+  out << "| scenario | estimator | seeds | E_p RMS (m) | bound (m) | E_p / bound | E_phi RMS (deg) | bound (deg) | "
+         "E_phi / bound |\n"
+      << "|---|---|---|---|---|---|---|---|---|\n";
+  char text[160];
+  for (const auto& row : rows) {
+    out << "| " << row.scenario << " | " << row.estimator << " | " << row.runs.size() << " | ";
+    if (row.bounds.size() != row.runs.size() || row.runs.empty()) {
+      out << "n/a | n/a: " << (row.bound_unavailable.empty() ? "no run scored" : row.bound_unavailable)
+          << " | | | | |\n";
+      continue;
+    }
+    std::vector<double> ep, bound_p, ephi, bound_phi;
+    bool same_poses = true;
+    for (std::size_t i = 0; i < row.runs.size(); ++i) {
+      same_poses = same_poses && row.bounds[i].samples == row.runs[i].samples;
+      ep.push_back(row.runs[i].position_rms_m);
+      bound_p.push_back(row.bounds[i].position_m);
+      if (row.runs[i].heading_rms_deg) {
+        ephi.push_back(*row.runs[i].heading_rms_deg);
+        bound_phi.push_back(row.bounds[i].heading_deg);
+      }
+    }
+    const auto ratio = [&](double ours, double bound) { return bound_ratio(row.laser_fused, same_poses, ours, bound); };
+    std::snprintf(text, sizeof text, "%.4f | %.4f | ", quadratic_mean(ep), quadratic_mean(bound_p));
+    out << text << ratio(quadratic_mean(ep), quadratic_mean(bound_p)) << " | ";
+    if (ephi.empty()) {
+      out << "n/a | n/a | n/a |\n";
+      continue;
+    }
+    std::snprintf(text, sizeof text, "%.3f | %.3f | ", quadratic_mean(ephi), quadratic_mean(bound_phi));
+    out << text << ratio(quadratic_mean(ephi), quadratic_mean(bound_phi)) << " |\n";
   }
   return out.str();
 }

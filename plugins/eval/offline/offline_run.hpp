@@ -10,11 +10,17 @@
 #include "beaconloc/core/estimator.hpp"
 #include "evaluation.hpp"
 #include "localizer_core.hpp"
+#include "pose_bound.hpp"
 #include "sim/scenario.hpp"
 #include "source.hpp"
 #include "tof_decoder.hpp"
 
 namespace beaconloc {
+
+// What the localizer is told of a scenario, as `beaconloc run --scenario` tells it: its
+// receivers, occupancy grid and start pose (or initial_pose).
+EstimatorConfig estimator_config_for(const sim::Scenario& scenario, const std::map<std::string, double>& parameters,
+                                     const std::optional<Pose2>& initial_pose = std::nullopt);
 
 // The decoder `beaconloc run --scenario` gives the scenario: its range limits and noise, its
 // beacon map as the gateway publishes it (locally referenced groups in their own frames).
@@ -68,6 +74,7 @@ struct OfflineRunResult {
   AssociationTally associations;
   RejectionCounter rejections;  // decoder.<reason> and localizer.<reason>
   std::uint64_t replays = 0;    // late measurements fused at their stamp by rolling back
+  PoseBoundResult bound;  // the posterior Cramer-Rao bound over the stamps scored (pose_bound.hpp)
 };
 
 // How the measurements reach the localizer: in stamp order, or each TOF and scan late by a
@@ -122,11 +129,19 @@ struct AccuracyRow {
   std::vector<Metrics> runs;                        // one per seed
   std::vector<AssociationTally> associations;       // one per seed, where the ranges are anonymous
   std::map<std::string, std::uint64_t> rejections;  // summed over the seeds
+  std::vector<PoseBoundRms> bounds;                 // one per seed scored, where the bound follows the scenario
+  std::string bound_unavailable;                    // why not, when it does not
+  bool laser_fused = false;
 };
 
 // A markdown table: mean and standard deviation over the seeds of E_p RMS, E_phi RMS, E_S mean
 // and the NEES-in-band fraction, one row per scenario and estimator.
 std::string accuracy_table_markdown(const std::vector<AccuracyRow>& rows);
+
+// The estimators beside the posterior Cramer-Rao bound (pose_bound.hpp): E_p RMS and E_phi RMS
+// as quadratic means over the seeds, the bound's the same way, and their ratios (1: at the bound;
+// each ratio is ours over the bound, both over the same seeds and stamps).
+std::string bound_table_markdown(const std::vector<AccuracyRow>& rows);
 
 // Seed 001 Tables 4-7: mean, standard deviation, RMS and maximum of the distance error, and the
 // rate of correct association per beacon and overall, each as mean +- spread over the seeds.

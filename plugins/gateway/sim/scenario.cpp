@@ -4,6 +4,8 @@
 #include <optional>
 #include <utility>
 
+#include "beaconloc/core/speed_of_sound.hpp"
+
 namespace beaconloc::sim {
 
 Scenario default_scenario() {
@@ -70,6 +72,29 @@ bool Scenario::nearest_group_is_local(double x_map_m, double y_map_m) const {
     }
   }
   return nearest && local_group_frames_map.count(*nearest) > 0;
+}
+
+Eigen::Vector2d alpha_velocity_variances(const std::array<double, 4>& alpha, double linear_mps, double angular_radps) {
+  return {alpha[0] * linear_mps * linear_mps + alpha[1] * angular_radps * angular_radps,
+          alpha[2] * linear_mps * linear_mps + alpha[3] * angular_radps * angular_radps};
+}
+
+Eigen::Matrix2d wheel_velocity_covariance(const Scenario& scenario, double right_mps, double left_mps,
+                                          double wheel_base_m, double dt_s) {
+  if (scenario.odometry_alpha) {
+    const double v = (right_mps + left_mps) / 2.0, w = (right_mps - left_mps) / wheel_base_m;
+    Eigen::Matrix2d to_wheels;
+    to_wheels << 1.0, wheel_base_m / 2.0, 1.0, -wheel_base_m / 2.0;
+    return to_wheels * alpha_velocity_variances(*scenario.odometry_alpha, v, w).asDiagonal() * to_wheels.transpose();
+  }
+  Eigen::Matrix2d c = Eigen::Matrix2d::Zero();
+  c.diagonal() << scenario.odometry_k_v_m * std::abs(right_mps) / dt_s, scenario.odometry_k_v_m * std::abs(left_mps) / dt_s;
+  return c;
+}
+
+double range_variance_m2(const Scenario& scenario) {
+  const double c = speed_of_sound_mps(scenario.temperature_c);
+  return scenario.range_sigma_m * scenario.range_sigma_m + c * c * scenario.tof_sigma_s * scenario.tof_sigma_s;
 }
 
 bool Faults::silences(std::uint32_t beacon_id, StampNs fire_ns) const {

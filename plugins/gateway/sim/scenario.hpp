@@ -106,6 +106,20 @@ struct Scenario {
   std::optional<LaserModel> laser;
 };
 
+// The scenario's noise models, as the simulator draws them (sim_source.cpp) and the pose bound
+// takes them (plugins/eval/offline/pose_bound.hpp): one definition for both.
+// Seed 001 eq. 6: the variances of (v, w) per odometry sample, alpha_1 v^2 + alpha_2 w^2 and
+// alpha_3 v^2 + alpha_4 w^2.
+Eigen::Vector2d alpha_velocity_variances(const std::array<double, 4>& alpha, double linear_mps, double angular_radps);
+// The covariance of the wheel speeds [v_R, v_L] one odometry sample of dt_s carries, at the wheel
+// speeds given: seed 000's sigma_v^2 = k_v |v| / dT per wheel, or seed 001's alpha model carried
+// to the wheels by [v_R, v_L] = [[1, B/2], [1, -B/2]] [v, w].
+Eigen::Matrix2d wheel_velocity_covariance(const Scenario& scenario, double right_mps, double left_mps,
+                                          double wheel_base_m, double dt_s);
+// The variance of a range from one time of flight: the range noise and the arrival-time noise
+// (times the speed of sound) are drawn independently.
+double range_variance_m2(const Scenario& scenario);
+
 // The built-in scenario `demo` and the tests run: seed 000's setup (six Txs at z_T = 2.011 m,
 // three Rxs on a 0.19 m circle, sigma_dd = 0.01 m, k_v = 4e-4 m, 0.34 m/s, 100 Hz odometry,
 // 200 ms slots) on a 2 m x 1.2 m stadium loop under a 3 x 2 beacon grid

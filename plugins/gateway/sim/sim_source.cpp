@@ -147,9 +147,8 @@ SourceEvent SimSource::odometry_at(StampNs stamp_ns) {
   double left = (v - w * half_track) * (1.0 + scenario_.wheel_radius_error_left);
   if (scenario_.odometry_alpha) {
     // Seed 001 eq. 6: noise on the velocities the robot reports, (v, w) from its wheels.
-    const auto& a = *scenario_.odometry_alpha;
-    const auto variances = [&a](double lin, double ang) {
-      return Eigen::Vector2d(a[0] * lin * lin + a[1] * ang * ang, a[2] * lin * lin + a[3] * ang * ang);
+    const auto variances = [this](double lin, double ang) {
+      return alpha_velocity_variances(*scenario_.odometry_alpha, lin, ang);
     };
     double v_meas = (right + left) / 2.0, w_meas = (right - left) / reported_base;
     const Eigen::Vector2d true_var = variances(v_meas, w_meas);
@@ -165,10 +164,10 @@ SourceEvent SimSource::odometry_at(StampNs stamp_ns) {
         to_wheels * variances(v_meas, w_meas).asDiagonal() * to_wheels.transpose();
   } else {
     // Seed 000: sigma_v^2 = k_v |v| / dT for each wheel, reported at what was measured.
-    right += std::sqrt(scenario_.odometry_k_v_m * std::abs(right) / dt_s) * normal();
-    left += std::sqrt(scenario_.odometry_k_v_m * std::abs(left) / dt_s) * normal();
-    e.odometry.wheel_velocity_covariance.diagonal() << scenario_.odometry_k_v_m * std::abs(right) / dt_s,
-        scenario_.odometry_k_v_m * std::abs(left) / dt_s;
+    const Eigen::Matrix2d drawn = wheel_velocity_covariance(scenario_, right, left, reported_base, dt_s);
+    right += std::sqrt(drawn(0, 0)) * normal();
+    left += std::sqrt(drawn(1, 1)) * normal();
+    e.odometry.wheel_velocity_covariance = wheel_velocity_covariance(scenario_, right, left, reported_base, dt_s);
   }
   e.odometry.wheel_velocity_right_mps = right;
   e.odometry.wheel_velocity_left_mps = left;
