@@ -66,6 +66,7 @@ TEST(Recordings, TucLabyrinthWithTheRangesCalibratedOnline) {
   decoding.range_sigma_m = 0.15;
   const ReplayRun r = replay(path, decoding, {}, {"init_window_s=5", "range_calibration=1"});
   ASSERT_GT(r.metrics.samples, 7000u);
+  ASSERT_TRUE(r.state.count("range_scale") && r.state.count("range_bias_m"));
   std::printf("TUC Labyrinth full: position RMS %.4f m, NEES in band %.2f, scale %.4f +- %.4f, bias %.3f +- %.3f m\n",
               r.metrics.position_rms_m, r.metrics.nees_in_band_fraction, r.state.at("range_scale").value,
               r.state.at("range_scale").sigma, r.state.at("range_bias_m").value, r.state.at("range_bias_m").sigma);
@@ -91,13 +92,20 @@ TEST(Recordings, CmuPlazaScaleLearntWithoutBeingGivenIt) {
                                {"init_window_s=20", "max_odometry_gap_s=0.5", "init_max_position_sigma_m=2",
                                 "init_max_yaw_sigma_rad=0.5", "range_calibration=1"});
     ASSERT_GT(r.metrics.samples, 3000u) << name;
+    ASSERT_TRUE(r.state.count("range_scale")) << name;
     const Estimator::StateValue& scale = r.state.at("range_scale");
     std::printf("%s: position RMS %.3f m, NEES in band %.2f, scale %.4f +- %.4f (the datasets' README: 1.069)\n", name,
                 r.metrics.position_rms_m, r.metrics.nees_in_band_fraction, scale.value, scale.sigma);
     EXPECT_LT(std::abs(scale.value / 1.069 - 1.0), 0.01) << name;
-    // Issue 18 asks 0.45 m; it is not met yet (0.480 and 0.554 m, docs/range-calibration.md):
-    // asserted here is that the calibration brings the run to what a hand-given scale gives.
-    EXPECT_LT(r.metrics.position_rms_m, 0.6) << name;
+    // Issue 18 asks 0.45 m; it is not met yet (docs/range-calibration.md). Asserted: the
+    // calibration learnt brings the run to within 10 % of what the scale handed in gives.
+    TofDecoderConfig given = decoding;
+    given.range_scale = 1.069;
+    const ReplayRun handed_in = replay(path, given, options,
+                                       {"init_window_s=20", "max_odometry_gap_s=0.5", "init_max_position_sigma_m=2",
+                                        "init_max_yaw_sigma_rad=0.5"});
+    std::printf("%s with --range-scale 1.069: position RMS %.3f m\n", name, handed_in.metrics.position_rms_m);
+    EXPECT_LT(r.metrics.position_rms_m, 1.1 * handed_in.metrics.position_rms_m) << name;
   }
   if (replayed == 0) GTEST_SKIP() << "no CMU Plaza recording beside the repository";
 }

@@ -12,8 +12,13 @@ std::optional<RangeCalibrationIndex> RangeCalibrationStates::index(std::uint32_t
   return RangeCalibrationIndex{at->second, at->second + 1};
 }
 
-RangeCalibrationIndex RangeCalibrationStates::add(std::uint32_t beacon_id, State& x, Covariance& p) {
+std::optional<RangeCalibrationIndex> RangeCalibrationStates::add(std::uint32_t beacon_id, State& x, Covariance& p) {
   if (const auto known = index(beacon_id)) return *known;
+  if (!enabled()) return std::nullopt;
+  if (scale_at_.size() >= kMaxPairs) {
+    uncalibrated_.insert(beacon_id);
+    return std::nullopt;
+  }
   const Eigen::Index n = x.size();
   State grown = State::Zero(n + 2);
   grown.head(n) = x;
@@ -25,7 +30,29 @@ RangeCalibrationIndex RangeCalibrationStates::add(std::uint32_t beacon_id, State
   x = std::move(grown);
   p = std::move(p_grown);
   scale_at_[key(beacon_id)] = n;
-  return {n, n + 1};
+  return RangeCalibrationIndex{n, n + 1};
+}
+
+bool RangeCalibrationStates::plausible(const State& x) const {
+  for (const auto& [k, s] : scale_at_) {
+    if (!(x(s) >= kMinScale && x(s) <= kMaxScale)) return false;
+  }
+  return true;
+}
+
+void RangeCalibrationStates::to_prior(State& x, Covariance& p, bool values) const {
+  const Eigen::Index n = x.size() - kPoseSize;
+  p.topRightCorner(kPoseSize, n).setZero();
+  p.bottomLeftCorner(n, kPoseSize).setZero();
+  p.bottomRightCorner(n, n).setZero();
+  for (const auto& [k, s] : scale_at_) {
+    p(s, s) = scale_sigma_ * scale_sigma_;
+    p(s + 1, s + 1) = bias_sigma_m_ * bias_sigma_m_;
+    if (values) {
+      x(s) = 1.0;
+      x(s + 1) = 0.0;
+    }
+  }
 }
 
 RangeCalibrationStates::Corrected RangeCalibrationStates::corrected(std::uint32_t beacon_id, double range_m,

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <vector>
 
 #include "beaconloc/core/estimator.hpp"
@@ -25,6 +26,16 @@ class RangeCalibrationStates {
   using State = Eigen::VectorXd;
   using Covariance = Eigen::MatrixXd;
   static constexpr Eigen::Index kPoseSize = 3;
+  // At most this many pairs (per beacon: 64 states beside the pose, whose covariance each
+  // odometry sample and range updates in full). The ranges of a beacon beyond them are fused as
+  // they are, and the beacon counted (uncalibrated_beacons).
+  static constexpr std::size_t kMaxPairs = 32;
+  // A scale outside this is no ranging system's: the calibration has diverged (an unobservable
+  // stretch linearized at a wrong pose) and starts again from its prior.
+  static constexpr double kMinScale = 0.5;
+  static constexpr double kMaxScale = 2.0;
+  // The largest prior sigma of a scale: 1 +- 3 sigma stays within (kMinScale, kMaxScale).
+  static constexpr double kMaxScaleSigma = 0.15;
 
   RangeCalibrationStates(RangeCalibrationMode mode, double scale_sigma, double bias_sigma_m)
       : mode_(mode), scale_sigma_(scale_sigma), bias_sigma_m_(bias_sigma_m) {}
@@ -34,8 +45,14 @@ class RangeCalibrationStates {
   // Where the beacon's scale and bias sit in the state; nullopt until they are in it.
   std::optional<RangeCalibrationIndex> index(std::uint32_t beacon_id) const;
   // Appends the beacon's pair (the shared pair, once) to x and P at the prior, uncorrelated
-  // with the rest; its index.
-  RangeCalibrationIndex add(std::uint32_t beacon_id, State& x, Covariance& p);
+  // with the rest; its index. nullopt when kMaxPairs are there already (the beacon counted).
+  std::optional<RangeCalibrationIndex> add(std::uint32_t beacon_id, State& x, Covariance& p);
+  // Whether every scale in x lies in [kMinScale, kMaxScale].
+  bool plausible(const State& x) const;
+  // Every pair back to its prior, uncorrelated with the pose: its values too (values), or only
+  // its covariance (the values kept as the start of a new search).
+  void to_prior(State& x, Covariance& p, bool values) const;
+  std::size_t uncalibrated_beacons() const { return uncalibrated_.size(); }
   // A range as the beacon's calibration in x reads it back to a distance, (range - bias) / scale,
   // and its variance (the calibration's own uncertainty is not in it: it is common to every range
   // of the beacon, and a fix carries it through its sensitivity to the calibration); the range
@@ -55,6 +72,7 @@ class RangeCalibrationStates {
   double scale_sigma_;
   double bias_sigma_m_;
   std::map<std::uint32_t, Eigen::Index> scale_at_;  // key -> the scale's index; the bias follows it
+  std::set<std::uint32_t> uncalibrated_;             // beacons heard beyond kMaxPairs
 };
 
 }  // namespace beaconloc

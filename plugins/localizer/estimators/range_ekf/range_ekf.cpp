@@ -51,7 +51,8 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
   p.divergence_gated_ranges =
       in.count("divergence_gated_ranges", p.divergence_gated_ranges, 1, p.divergence_window_ranges);
   p.range_calibration = in.count("range_calibration", p.range_calibration, 0, 2);
-  p.range_scale_sigma = in.real("range_scale_sigma", p.range_scale_sigma, ParameterRange::above(0.0, 1.0));
+  p.range_scale_sigma = in.real("range_scale_sigma", p.range_scale_sigma,
+                                ParameterRange::above(0.0, RangeCalibrationStates::kMaxScaleSigma));
   p.range_bias_sigma_m = in.real("range_bias_sigma_m", p.range_bias_sigma_m, ParameterRange::above(0.0, 100.0));
   in.finish();
   return p;
@@ -121,6 +122,10 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r) {
   switch (result.outcome) {
     case FilterOutcome::kApplied:
       consecutive_gated_ = 0;
+      if (calibration_.enabled() && !calibration_.plausible(calibrating_.state())) {
+        calibration_to_prior(true);
+        ++calibration_resets_;
+      }
       corrected(std::max(r.stamp_ns, now_ns().value_or(r.stamp_ns)));
       watch_divergence({false, result.nis});
       return InputResult::ok();
@@ -132,8 +137,10 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r) {
   ++consecutive_gated_;
   watch_divergence({true, result.nis});
   if (has_pose() && consecutive_gated_ >= params_.reinitialize_after_gated) {
-    // The filter no longer agrees with the beacons: start again from a global fix.
+    // The filter no longer agrees with the beacons: start again from a global fix, and let the
+    // calibration (which may be what went wrong) be learnt again from its values now.
     forget_pose();
+    if (calibration_.enabled()) calibration_to_prior(false);
     consecutive_gated_ = 0;
     try_initialize();
   }
@@ -213,7 +220,8 @@ void RangeEkf::start_from(const WindowFix& fix, StampNs correction_stamp_ns) {
   if (calibration_.enabled() && fix.calibration_sensitivity.cols() == calibrating_.state().size() - 3) {
     // The fix read its ranges back with the calibration as it stands: its error moves with the
     // calibration's, P_pose = P_fix + J P_cal J^T and P_pose,cal = J P_cal (first order), so
-    // that the ranges that make the calibration observable correct the pose with it.
+    // that the ranges that make the calibration observable correct the pose with it. (J is
+    // taken with the solver's C, P_fix with the fix's inflated one: conservative.)
     Eigen::MatrixXd p = calibrating_.covariance();
     const Eigen::Index n = p.rows() - 3;
     const Eigen::MatrixXd& j = fix.calibration_sensitivity;
@@ -221,7 +229,9 @@ void RangeEkf::start_from(const WindowFix& fix, StampNs correction_stamp_ns) {
     p.topLeftCorner<3, 3>() += cross * j.transpose();
     p.topRightCorner(3, n) = cross;
     p.bottomLeftCorner(n, 3) = cross.transpose();
-    calibrating_.reset(calibrating_.state(), p);
+    // T diag(P_fix, P_cal) T^T with T = [I J; 0 I]: positive semi-definite. A non-finite J
+    // (refused by reset) leaves the fix uncorrelated with the calibration.
+    calibrating_.reset(calibrating_.state(), symmetrized(p));
   }
   start(correction_stamp_ns);
 }
@@ -382,15 +392,26 @@ RangeCalibrationIndex RangeEkf::calibration_of(std::uint32_t beacon_id) {
   if (const auto known = calibration_.index(beacon_id)) return *known;
   Eigen::VectorXd x = calibrating_.state();
   Eigen::MatrixXd p = calibrating_.covariance();
-  const RangeCalibrationIndex added = calibration_.add(beacon_id, x, p);
+  const std::optional<RangeCalibrationIndex> added = calibration_.add(beacon_id, x, p);
+  if (!added) return {};
   calibrating_ = Ekf<Eigen::Dynamic>(StateSpace<Eigen::Dynamic>::with_pose({}, x.size()));
+  calibrating_.reset(x, p);  // the old belief, finite, with a pair at its prior: accepted
+  return *added;
+}
+
+void RangeEkf::calibration_to_prior(bool values) {
+  Eigen::VectorXd x = calibrating_.state();
+  Eigen::MatrixXd p = calibrating_.covariance();
+  calibration_.to_prior(x, p, values);
   calibrating_.reset(x, p);
-  return added;
 }
 
 std::vector<Estimator::StateValue> RangeEkf::state_values() const {
   if (!calibration_.enabled()) return {};
-  return calibration_.values(calibrating_.state(), calibrating_.covariance());
+  std::vector<StateValue> out = calibration_.values(calibrating_.state(), calibrating_.covariance());
+  out.push_back({"range_calibration_resets", static_cast<double>(calibration_resets_), 0.0});
+  out.push_back({"range_calibration_uncalibrated_beacons", static_cast<double>(calibration_.uncalibrated_beacons()), 0.0});
+  return out;
 }
 
 namespace {

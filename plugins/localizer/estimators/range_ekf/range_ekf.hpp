@@ -115,8 +115,12 @@ class RangeEkf final : public EstimatorBase {
   decltype(auto) with_filter(F&& f) const {
     return calibration_.enabled() ? f(calibrating_) : f(ekf_);
   }
-  // The beacon's scale and bias, put in the state at the prior when first heard.
+  // The beacon's scale and bias, put in the state at the prior when first heard; none (the range
+  // as it is) beyond RangeCalibrationStates::kMaxPairs.
   RangeCalibrationIndex calibration_of(std::uint32_t beacon_id);
+  // The calibration back to its prior: its values too (values), or its covariance alone.
+  void calibration_to_prior(bool values);
+  std::uint64_t calibration_resets_ = 0;  // a scale left [kMinScale, kMaxScale]: started again
   Ekf<3> ekf_{pose_space()};
   RangeCalibrationStates calibration_;
   Ekf<Eigen::Dynamic> calibrating_{StateSpace<Eigen::Dynamic>::with_pose({}, RangeCalibrationStates::kPoseSize)};

@@ -20,12 +20,12 @@ TEST(RangeCalibrationStates, AddsAPairAtThePriorPerBeaconOrOneSharedPair) {
   Eigen::VectorXd x = Eigen::VectorXd::Constant(3, 7.0);
   Eigen::MatrixXd p = Eigen::MatrixXd::Identity(3, 3);
   EXPECT_FALSE(per_beacon.index(4));
-  const RangeCalibrationIndex four = per_beacon.add(4, x, p);
-  const RangeCalibrationIndex nine = per_beacon.add(9, x, p);
+  const RangeCalibrationIndex four = *per_beacon.add(4, x, p);
+  const RangeCalibrationIndex nine = *per_beacon.add(9, x, p);
   EXPECT_EQ(*four.scale, 3);
   EXPECT_EQ(*four.bias_m, 4);
   EXPECT_EQ(*nine.scale, 5);
-  EXPECT_EQ(per_beacon.add(4, x, p).scale, four.scale);  // once per beacon
+  EXPECT_EQ(per_beacon.add(4, x, p)->scale, four.scale);  // once per beacon
   ASSERT_EQ(x.size(), 7);
   EXPECT_EQ(x(3), 1.0);
   EXPECT_EQ(x(4), 0.0);
@@ -48,10 +48,41 @@ TEST(RangeCalibrationStates, AddsAPairAtThePriorPerBeaconOrOneSharedPair) {
   Eigen::VectorXd xs = Eigen::VectorXd::Zero(3);
   Eigen::MatrixXd ps = Eigen::MatrixXd::Identity(3, 3);
   shared.add(4, xs, ps);
-  EXPECT_EQ(shared.add(9, xs, ps).scale, shared.index(4)->scale);
+  EXPECT_EQ(shared.add(9, xs, ps)->scale, shared.index(4)->scale);
   EXPECT_EQ(xs.size(), 5);
   EXPECT_EQ(shared.values(xs, ps)[0].name, "range_scale");
   EXPECT_FALSE(RangeCalibrationStates(RangeCalibrationMode::kNone, 0.1, 0.5).index(4));
+}
+
+TEST(RangeCalibrationStates, BoundedInSizeAndAScaleNoRangingSystemHasStartsAgain) {
+  RangeCalibrationStates per_beacon(RangeCalibrationMode::kPerBeacon, 0.1, 0.5);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
+  Eigen::MatrixXd p = Eigen::MatrixXd::Identity(3, 3);
+  for (std::uint32_t id = 0; id < RangeCalibrationStates::kMaxPairs; ++id) ASSERT_TRUE(per_beacon.add(id, x, p));
+  EXPECT_FALSE(per_beacon.add(1000, x, p));  // beyond the cap: fused as it is, and counted
+  EXPECT_FALSE(per_beacon.add(1000, x, p));
+  EXPECT_FALSE(per_beacon.add(1001, x, p));
+  EXPECT_EQ(per_beacon.uncalibrated_beacons(), 2u);
+  EXPECT_EQ(x.size(), static_cast<Eigen::Index>(3 + 2 * RangeCalibrationStates::kMaxPairs));
+  EXPECT_TRUE(per_beacon.plausible(x));
+  const Eigen::Index s = *per_beacon.index(7)->scale;
+  x(s) = 0.3;  // diverged
+  x(s + 1) = 4.0;
+  p(0, s) = p(s, 0) = 0.5;
+  p(s, s) = 1e-8;
+  EXPECT_FALSE(per_beacon.plausible(x));
+  Eigen::VectorXd kept = x;
+  Eigen::MatrixXd kept_p = p;
+  per_beacon.to_prior(kept, kept_p, false);  // covariance only
+  EXPECT_EQ(kept(s), 0.3);
+  EXPECT_DOUBLE_EQ(kept_p(s, s), 0.01);
+  EXPECT_EQ(kept_p(0, s), 0.0);
+  per_beacon.to_prior(x, p, true);
+  EXPECT_EQ(x(s), 1.0);
+  EXPECT_EQ(x(s + 1), 0.0);
+  EXPECT_TRUE(per_beacon.plausible(x));
+  EXPECT_DOUBLE_EQ(p(s + 1, s + 1), 0.25);
+  EXPECT_EQ(p(0, 0), 1.0);  // the pose's own variance stays
 }
 
 // The first seconds, while the calibration is learnt, are not scored in `metrics`.
@@ -123,6 +154,7 @@ TEST(RangeEkfCalibration, FindsTheRangesScaleAndBiasOnlineAndTracksAsIfCalibrate
     EXPECT_LT(per_beacon.metrics.position_rms_m, 0.25 * none.metrics.position_rms_m) << "seed " << seed;
     EXPECT_GT(none.metrics.position_rms_m, 2.0 * shared.metrics.position_rms_m) << "seed " << seed;
     EXPECT_GT(shared.metrics.nees_in_band_fraction, 0.85) << "seed " << seed;
+    EXPECT_EQ(shared.state.at("range_calibration_resets").value, 0.0);
     std::printf("seed %llu: scale %.4f +- %.4f, bias %.3f +- %.3f m; E_p RMS from %.0f s %.4f m (per beacon %.4f m, "
                 "calibrated sensor %.4f m, uncalibrated %.4f m); from the first pose %.4f m (calibrated sensor %.4f m)\n",
                 static_cast<unsigned long long>(seed), scale.value, scale.sigma, bias.value, bias.sigma, kLearnS,
@@ -131,10 +163,12 @@ TEST(RangeEkfCalibration, FindsTheRangesScaleAndBiasOnlineAndTracksAsIfCalibrate
   }
 }
 
-// A robot standing still hears each beacon from one place: a calibrated sensor stays calibrated
-// (no scale or bias is made up from so little), and the pose is as uncertain as the calibration
-// leaves it, honestly so: standing, a bias per beacon trades with the position.
-TEST(RangeEkfCalibration, AStandingRobotMakesUpNoCalibration) {
+// A robot standing still with a calibrated sensor: no scale or bias is made up, and the pose is
+// as uncertain as the calibration leaves it, honestly so (standing, a bias per beacon trades with
+// the position). Not asserted, because not so: with a miscalibrated sensor, standing, the
+// calibration comes out overconfident (an EKF linearized along a direction the ranges do not
+// see; docs/range-calibration.md).
+TEST(RangeEkfCalibration, AStandingRobotWithACalibratedSensorMakesUpNoCalibration) {
   sim::Scenario s = miscalibrated();
   s.range_scale = 1.0;
   s.range_bias_m = 0.0;
@@ -149,7 +183,7 @@ TEST(RangeEkfCalibration, AStandingRobotMakesUpNoCalibration) {
       std::printf("  %s %.4f +- %.4f\n", name.c_str(), v.value, v.sigma);
       if (name.rfind("range_scale", 0) == 0) {
         EXPECT_LT(std::abs(v.value - 1.0), 3.0 * v.sigma) << name;
-      } else {
+      } else if (name.rfind("range_bias_m", 0) == 0) {
         EXPECT_LT(std::abs(v.value), 3.0 * v.sigma) << name;
       }
     }
