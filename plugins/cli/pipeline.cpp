@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <sstream>
@@ -233,6 +234,23 @@ PoseBoundResult bound_of_run(const PipelineOptions& o, const LoadedSource& sourc
   return pose_bound_of_run(scenario, events, scored_ns, estimator);
 }
 
+// Each value the estimator published, at its newest stamp: "name value +- sigma, ...".
+std::string newest_state(const std::vector<EstimatorStateRow>& state) {
+  std::map<std::string, const EstimatorStateRow*> newest;
+  for (const EstimatorStateRow& row : state) {
+    const EstimatorStateRow*& at = newest[row.robot_id + " " + row.value.name];
+    if (!at || row.stamp_ns >= at->stamp_ns) at = &row;
+  }
+  std::string out;
+  for (const auto& [key, row] : newest) {
+    char text[160];
+    std::snprintf(text, sizeof text, "%s%s %.6g +- %.3g", out.empty() ? "" : ", ", key.c_str(), row->value.value,
+                  row->value.sigma);
+    out += text;
+  }
+  return out;
+}
+
 // Scores and writes the outputs shared by both modes.
 PipelineResult finish(const PipelineOptions& o, const LoadedSource& source, const BeaconMap& beacons,
                       const std::vector<RecordedPose>& poses, const TruthTrack& truth,
@@ -260,6 +278,7 @@ PipelineResult finish(const PipelineOptions& o, const LoadedSource& source, cons
     if (!state.empty()) write_estimator_state_csv(o.out_dir + "/estimator_state.csv", state);
   }
   r.estimator_state_rows = state.size();
+  r.newest_state = newest_state(state);
   // After the files: whatever the bound meets, the run's outputs are written.
   if (source.scenario) r.bound = bound_of_run(o, source, poses, truth, eval);
   return r;

@@ -79,6 +79,7 @@ struct PipelineResult {
   std::size_t truth_samples = 0;  // 0: the source has no ground truth (a replay without gt.csv)
   std::string diagnostics;        // each participant's counts, one line each
   std::size_t estimator_state_rows = 0;  // written to estimator_state.csv (estimators with such state)
+  std::string newest_state;              // each value of that state at its newest stamp, with its sigma
   std::optional<PoseBoundResult> bound;  // simulated sources: the posterior Cramer-Rao bound (docs/bound.md)
 };
 

@@ -251,12 +251,13 @@ struct Recording {
 TEST_F(Run, ReplaysTheSharedRecordings) {
   const std::vector<Recording> recordings = {
       {"tuc_labyrinth_uwb/replay/full_933s",
-       {"--max-range-m", "10", "--range-sigma-m", "0.15", "--param", "init_window_s=5"},
+       {"--max-range-m", "10", "--range-sigma-m", "0.15", "--param", "init_window_s=5", "--param",
+        "range_calibration=1"},
        0.5},
       {"cmu_plaza_gpslam/replay/plaza1",
-       {"--max-range-m", "150", "--range-sigma-m", "1.0", "--range-scale", "1.069", "--replay-odometry-k-v",
-        "0.002", "--param", "init_window_s=20", "--param", "max_odometry_gap_s=0.5", "--param",
-        "init_max_position_sigma_m=2", "--param", "init_max_yaw_sigma_rad=0.5"},
+       {"--max-range-m", "150", "--range-sigma-m", "1.0", "--replay-odometry-k-v", "0.002", "--param",
+        "init_window_s=20", "--param", "max_odometry_gap_s=0.5", "--param", "init_max_position_sigma_m=2", "--param",
+        "init_max_yaw_sigma_rad=0.5", "--param", "range_calibration=1"},
        2.0}};
   int replayed = 0;
   for (const auto& r : recordings) {
@@ -277,6 +278,10 @@ TEST_F(Run, ReplaysTheSharedRecordings) {
     std::printf("%s: %s", r.dir, metrics.c_str());
     EXPECT_LT(json_number(metrics, "position_rms_m"), r.max_rms_m) << r.dir;
     EXPECT_GT(json_number(metrics, "samples"), 5000) << r.dir;
+    // The calibration learnt is printed at the end, with its sigma.
+    EXPECT_NE(out.find("estimator state at the end (robot name value +- sigma): robot1 range_bias_m "),
+              std::string::npos)
+        << out;
   }
   if (replayed == 0) GTEST_SKIP() << "no shared dataset beside the repository";
 }

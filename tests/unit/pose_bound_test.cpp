@@ -136,6 +136,8 @@ TEST(PoseBound, CausesOfErrorItDoesNotModelAreRefusedWithTheReason) {
   refused([](sim::Scenario& s) { s.wheel_radius_error_left = 0.01; }, "wheel");
   refused([](sim::Scenario& s) { s.wheel_base_error = -0.01; }, "wheel");
   refused([](sim::Scenario& s) { s.reported_temperature_c = s.temperature_c + 5.0; }, "temperature");
+  refused([](sim::Scenario& s) { s.range_scale = 1.069; }, "ranging calibration");
+  refused([](sim::Scenario& s) { s.range_bias_m = 0.1; }, "ranging calibration");
   sim::Scenario fine = sim::default_scenario();
   fine.reported_temperature_c = fine.temperature_c;
   EXPECT_FALSE(pose_bound_unsupported(fine));

@@ -33,6 +33,7 @@ class PipelineCommand : public Command {
     const bool has_truth = r.truth_samples > 0;
     std::printf("poses: %zu at %.1f Hz; %s\n", r.poses, r.pose_rate_hz,
                 has_truth ? format_metrics(r.metrics).c_str() : "no ground truth: not scored");
+    if (!r.newest_state.empty()) std::cout << "estimator state at the end (robot name value +- sigma): " << r.newest_state << '\n';
     if (r.bound && r.metrics.samples) {
       std::cout << format_pose_bound(*r.bound, r.metrics) << '\n';
     }

@@ -28,6 +28,7 @@ std::optional<std::string> pose_bound_unsupported(const sim::Scenario& s) {
   if (s.wheel_radius_error_right != 0.0 || s.wheel_radius_error_left != 0.0 || s.wheel_base_error != 0.0) {
     return "systematic wheel errors (a bias is not in the bound)";
   }
+  if (s.range_scale != 1.0 || s.range_bias_m != 0.0) return "a ranging calibration error (every range biased)";
   if (s.reported_temperature_c && *s.reported_temperature_c != s.temperature_c) {
     return "a reported temperature off the truth (every range biased)";
   }

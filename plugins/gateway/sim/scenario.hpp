@@ -73,6 +73,10 @@ struct Scenario {
   std::optional<std::uint32_t> marked_beacon_id;  // recognisable even when anonymous
   double range_sigma_m = 0.01;                    // seed 000: sigma_dd
   double tof_sigma_s = 0.0;                       // seed 002: arrival-time noise
+  // The ranging system's calibration error: a flight path d reads as range_scale * d +
+  // range_bias_m (a radio's clock rate and delay, as CMU Plaza's read 6.9 % long).
+  double range_scale = 1.0;
+  double range_bias_m = 0.0;
   double min_range_m = 0.0;                       // a receiver hears slant ranges in [min, max]
   double max_range_m = 5.0;
   double beam_half_angle_rad = M_PI / 2;         // cone around the beacon's downward axis

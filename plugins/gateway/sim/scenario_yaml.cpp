@@ -187,7 +187,7 @@ void read_beacon_system(const Section& root, Scenario& sc) {
   if (!root.has("beacon_system")) return;
   const Section s = root.child(
       "beacon_system", {"slot_period_s", "first_slot_s", "firing_order", "identified", "radio_sync", "marked_beacon_id",
-                        "range_sigma_m", "tof_sigma_s", "min_range_m", "max_range_m", "beam_half_angle_deg",
+                        "range_sigma_m", "tof_sigma_s", "range_scale", "range_bias_m", "min_range_m", "max_range_m", "beam_half_angle_deg",
                         "group_coverage_radius_m", "temperature_c", "reported_temperature_c", "echo"});
   sc.slot_period_ns = duration_ns(s, "slot_period_s", 0.2);
   sc.first_slot_ns = s_to_ns(s.number("first_slot_s", 0.05, 0.0, 3600.0));
@@ -210,6 +210,8 @@ void read_beacon_system(const Section& root, Scenario& sc) {
   if (s.has("marked_beacon_id")) sc.marked_beacon_id = s.get<std::uint32_t>("marked_beacon_id", 0);
   sc.range_sigma_m = s.number("range_sigma_m", 0.01, 0.0, 100.0);
   sc.tof_sigma_s = s.number("tof_sigma_s", 0.0, 0.0, 1.0);
+  sc.range_scale = s.number("range_scale", 1.0, 0.5, 2.0);
+  sc.range_bias_m = s.number("range_bias_m", 0.0, -10.0, 10.0);
   sc.min_range_m = s.number("min_range_m", 0.0, 0.0, kMaxRangeM);
   sc.max_range_m = s.number("max_range_m", 5.0, 0.0, kMaxRangeM);
   if (sc.max_range_m <= sc.min_range_m)

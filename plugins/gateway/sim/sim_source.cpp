@@ -105,6 +105,9 @@ void SimSource::fire(StampNs fire_ns) {
     e.tof.fire_stamp_ns = fire_ns;
     e.tof.tof_s =
         arrival_s - fire_s + scenario_.range_sigma_m / c * normal() + scenario_.tof_sigma_s * normal();
+    if (scenario_.range_scale != 1.0 || scenario_.range_bias_m != 0.0) {  // the clean path stays bit for bit
+      e.tof.tof_s += ((scenario_.range_scale - 1.0) * (arrival_s - fire_s) * c + scenario_.range_bias_m) / c;
+    }
     if (scenario_.echo.probability > 0.0 && uniform() < scenario_.echo.probability) {
       const auto& echo = scenario_.echo;
       e.tof.tof_s +=

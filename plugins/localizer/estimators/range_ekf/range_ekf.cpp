@@ -50,6 +50,10 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
   p.divergence_window_ranges = in.count("divergence_window_ranges", p.divergence_window_ranges, 1, 1000);
   p.divergence_gated_ranges =
       in.count("divergence_gated_ranges", p.divergence_gated_ranges, 1, p.divergence_window_ranges);
+  p.range_calibration = in.count("range_calibration", p.range_calibration, 0, 2);
+  p.range_scale_sigma = in.real("range_scale_sigma", p.range_scale_sigma,
+                                ParameterRange::above(0.0, RangeCalibrationStates::kMaxScaleSigma));
+  p.range_bias_sigma_m = in.real("range_bias_sigma_m", p.range_bias_sigma_m, ParameterRange::above(0.0, 100.0));
   in.finish();
   return p;
 }
@@ -57,7 +61,11 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
 RangeEkf::RangeEkf(const EstimatorConfig& config) : RangeEkf(config, RangeEkfParameters::from(config)) {}
 
 RangeEkf::RangeEkf(const EstimatorConfig& config, const RangeEkfParameters& params)
-    : EstimatorBase(params.max_odometry_gap_s), receivers_(config.receivers), params_(params) {
+    : EstimatorBase(params.max_odometry_gap_s),
+      receivers_(config.receivers),
+      params_(params),
+      calibration_(static_cast<RangeCalibrationMode>(params.range_calibration), params.range_scale_sigma,
+                   params.range_bias_sigma_m) {
   waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(params_.init_min_beacons), {}};
 }
 
@@ -73,8 +81,9 @@ InputResult RangeEkf::predict(const OdometrySample& o) {
                                  o.wheel_velocity_covariance +
                                      params_.wheel_velocity_variance_floor_m2ps2 * Eigen::Matrix2d::Identity());
     // Eq. 14, 16: P = J_f,x P J_f,x^T + J_f,u U J_f,u^T.
-    const PredictResult predicted = ekf_.predict(
-        motion, Eigen::Vector2d(o.wheel_velocity_right_mps, o.wheel_velocity_left_mps), dt_s);
+    const PredictResult predicted = with_filter([&](auto& filter) {
+      return filter.predict(motion, Eigen::Vector2d(o.wheel_velocity_right_mps, o.wheel_velocity_left_mps), dt_s);
+    });
     if (!predicted.applied()) return InputResult::of(predicted.outcome);
   }
   return InputResult::ok();
@@ -106,11 +115,17 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
 InputResult RangeEkf::fuse(const RangeMeasurement& r) {
   const Beacon& beacon = *map().find(r.beacon_id);
   const RangeModel model(receivers_.receivers_base_m[r.receiver_id], receivers_.receiver_height_m,
-                         beacon.position_map_m, r.variance_m2);
-  const UpdateResult result = ekf_.update(model, RangeModel::Vector(r.range_m), params_.nis_gate);
+                         beacon.position_map_m, r.variance_m2, PoseIndex{},
+                         calibration_.enabled() ? calibration_of(r.beacon_id) : RangeCalibrationIndex{});
+  const UpdateResult result = with_filter(
+      [&](auto& filter) { return filter.update(model, RangeModel::Vector(r.range_m), params_.nis_gate); });
   switch (result.outcome) {
     case FilterOutcome::kApplied:
       consecutive_gated_ = 0;
+      if (calibration_.enabled() && !calibration_.plausible(calibrating_.state())) {
+        calibration_to_prior(true);
+        ++calibration_resets_;
+      }
       corrected(std::max(r.stamp_ns, now_ns().value_or(r.stamp_ns)));
       watch_divergence({false, result.nis});
       return InputResult::ok();
@@ -122,8 +137,10 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r) {
   ++consecutive_gated_;
   watch_divergence({true, result.nis});
   if (has_pose() && consecutive_gated_ >= params_.reinitialize_after_gated) {
-    // The filter no longer agrees with the beacons: start again from a global fix.
+    // The filter no longer agrees with the beacons: start again from a global fix, and let the
+    // calibration (which may be what went wrong) be learnt again from its values now.
     forget_pose();
+    if (calibration_.enabled()) calibration_to_prior(false);
     consecutive_gated_ = 0;
     try_initialize();
   }
@@ -157,15 +174,16 @@ void RangeEkf::watch_divergence(const RangeOutcome& outcome) {
   if (!fix.ok) return;  // nothing to settle it with yet: the pose stays degraded
   // Contradicted: the fix lies outside the pose's uncertainty and explains the window's ranges
   // better by the margin (echoes capped, so that they weigh on both alike).
-  const Eigen::Vector3d d = pose_difference(fix.pose, ekf_.state());
+  const PoseBelief belief = pose_belief();
+  const Eigen::Vector3d d = pose_difference(fix.pose, belief.pose_map_base);
   const double cap_sigma = params_.init_outlier_gate_sigma > 0.0 ? params_.init_outlier_gate_sigma
                                                                  : std::numeric_limits<double>::infinity();
   const double fix_cost = truncated_range_cost(fix.observations, fix.pose, cap_sigma);
-  const double pose_cost = truncated_range_cost(fix.observations, ekf_.state(), cap_sigma);
+  const double pose_cost = truncated_range_cost(fix.observations, belief.pose_map_base, cap_sigma);
   const double margin = kPoseMarginChiSquare * fix.variance_factor;
-  if (d.dot((ekf_.covariance() + fix.covariance).ldlt().solve(d)) > kChiSquare999ThreeDof &&
+  if (d.dot((belief.covariance + fix.covariance).ldlt().solve(d)) > kChiSquare999ThreeDof &&
       pose_cost - fix_cost > margin) {
-    start_from(fix.pose, fix.covariance, std::max(newest_range_ns, now_ns().value_or(newest_range_ns)));
+    start_from(fix, std::max(newest_range_ns, now_ns().value_or(newest_range_ns)));
     ++divergence_reinitializations_;
   }
   recent_.clear();  // explained: by a wrong pose now replaced, or by outliers the fix agrees on
@@ -180,22 +198,58 @@ bool RangeEkf::attempt_due(StampNs newest_range_ns) const {
 void RangeEkf::try_initialize() {
   const StampNs newest_range_ns = window_.back().range.stamp_ns;
   if (!attempt_due(newest_range_ns)) return;
+  calibrate_window_beacons();
   const WindowFix fix = window_fix();
   if (fix.solved) last_init_attempt_ns_ = newest_range_ns;
   if (!fix.ok) {
     waiting_for_ = fix.why_not;
     return;
   }
-  start_from(fix.pose, fix.covariance, std::max(newest_range_ns, now_ns().value_or(newest_range_ns)));
+  start_from(fix, std::max(newest_range_ns, now_ns().value_or(newest_range_ns)));
 }
 
-void RangeEkf::start_from(const Pose2& pose, const Cov3& covariance, StampNs correction_stamp_ns) {
-  place(pose, covariance);
+void RangeEkf::calibrate_window_beacons() {
+  if (!calibration_.enabled()) return;
+  for (const BufferedRange& b : window_) {
+    if (map().find(b.range.beacon_id)) calibration_of(b.range.beacon_id);
+  }
+}
+
+void RangeEkf::start_from(const WindowFix& fix, StampNs correction_stamp_ns) {
+  place(fix.pose, fix.covariance);
+  if (calibration_.enabled() && fix.calibration_sensitivity.cols() == calibrating_.state().size() - 3) {
+    // The fix read its ranges back with the calibration as it stands: its error moves with the
+    // calibration's, P_pose = P_fix + J P_cal J^T and P_pose,cal = J P_cal (first order), so
+    // that the ranges that make the calibration observable correct the pose with it. (J is
+    // taken with the solver's C, P_fix with the fix's inflated one: conservative.)
+    Eigen::MatrixXd p = calibrating_.covariance();
+    const Eigen::Index n = p.rows() - 3;
+    const Eigen::MatrixXd& j = fix.calibration_sensitivity;
+    const Eigen::MatrixXd cross = j * p.bottomRightCorner(n, n);
+    p.topLeftCorner<3, 3>() += cross * j.transpose();
+    p.topRightCorner(3, n) = cross;
+    p.bottomLeftCorner(n, 3) = cross.transpose();
+    // T diag(P_fix, P_cal) T^T with T = [I J; 0 I]: positive semi-definite. A non-finite J
+    // (refused by reset) leaves the fix uncorrelated with the calibration.
+    calibrating_.reset(calibrating_.state(), symmetrized(p));
+  }
   start(correction_stamp_ns);
 }
 
 bool RangeEkf::place(const Pose2& pose, const Cov3& covariance) {
-  ekf_.reset(pose, covariance);  // a checked pose (check_initial_pose) or a global fix
+  // A checked pose (check_initial_pose) or a global fix. The calibration is the sensor's, not
+  // the pose's: it stays, its correlation with the old pose dropped.
+  if (calibration_.enabled()) {
+    Eigen::VectorXd x = calibrating_.state();
+    Eigen::MatrixXd p = calibrating_.covariance();
+    x.head<3>() = pose;
+    p.topRows<3>().setZero();
+    p.leftCols<3>().setZero();
+    p.topLeftCorner<3, 3>() = covariance;
+    calibrating_.reset(x, p);
+  } else {
+    ekf_.reset(pose, covariance);
+  }
   consecutive_gated_ = 0;
   recent_.clear();
   suspect_ = false;
@@ -238,6 +292,7 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
   }
 
   std::vector<RangeObservation> observations;
+  std::vector<std::uint32_t> observed_beacons;  // beside observations
   for (std::size_t k = 0; k < window_.size(); ++k) {
     const BufferedRange& b = window_[k];
     const Beacon* beacon = map().find(b.range.beacon_id);
@@ -249,10 +304,14 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
     o.receiver_solve_frame_m = transform_point(then_in_now, receivers_.receivers_base_m[b.range.receiver_id]);
     o.receiver_z_m = receivers_.receiver_height_m;
     o.beacon_map_m = beacon->position_map_m;
-    o.range_m = b.range.range_m;
+    // The range as the calibration learnt so far reads it (as it is, without calibration).
+    const RangeCalibrationStates::Corrected range = calibration_.corrected(
+        b.range.beacon_id, b.range.range_m, b.range.variance_m2, calibrating_.state());
+    o.range_m = range.range_m;
     // Odometry drift over the window adds to the range noise: 2 % of the distance travelled.
-    o.variance_m2 = b.range.variance_m2 + std::pow(0.02 * travelled_m, 2);
+    o.variance_m2 = range.variance_m2 + std::pow(0.02 * travelled_m, 2);
     observations.push_back(o);
+    observed_beacons.push_back(b.range.beacon_id);
   }
   // Three unknowns: with fewer than init_min_ranges ranges an echo among them fits as well as the
   // truth does; wait for redundancy.
@@ -299,9 +358,59 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
   }
   out.ok = true;
   out.pose = fix.pose;
+  if (calibration_.enabled()) {
+    // d pose / d r_i = C H_i^T / var_i at the fix (C = (H^T R^-1 H)^-1), over the ranges the fix
+    // kept; a range read back as d = (r - b) / s moves by -d / s with the scale, -1 / s with the bias.
+    const Eigen::VectorXd& x = calibrating_.state();
+    out.calibration_sensitivity = Eigen::MatrixXd::Zero(3, x.size() - 3);
+    for (std::size_t i = 0; i < observations.size(); ++i) {
+      const RangeObservation& o = observations[i];
+      const RangePrediction h = predict_range(fix.pose, o.receiver_solve_frame_m, o.receiver_z_m, o.beacon_map_m);
+      const double residual_sigma = std::abs(o.range_m - h.range_m) / std::sqrt(o.variance_m2);
+      if (params_.init_outlier_gate_sigma > 0.0 && residual_sigma > params_.init_outlier_gate_sigma) continue;
+      const auto at = calibration_.index(observed_beacons[i]);
+      if (!at) continue;
+      const Eigen::Vector3d a = fix.covariance * h.jacobian_pose.transpose() / o.variance_m2;
+      const double scale = x(*at->scale);
+      out.calibration_sensitivity.col(*at->scale - 3) -= a * (o.range_m / scale);
+      out.calibration_sensitivity.col(*at->bias_m - 3) -= a / scale;
+    }
+  }
   out.observations = std::move(observations);
   // The fix ignores the correlation the shared odometry introduces: inflate it.
   out.covariance = 4.0 * fix.covariance + Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal().toDenseMatrix();
+  return out;
+}
+
+EstimatorBase::PoseBelief RangeEkf::pose_belief() const {
+  return with_filter([](const auto& filter) {
+    return PoseBelief{filter.state().template head<3>(), filter.covariance().template topLeftCorner<3, 3>()};
+  });
+}
+
+RangeCalibrationIndex RangeEkf::calibration_of(std::uint32_t beacon_id) {
+  if (const auto known = calibration_.index(beacon_id)) return *known;
+  Eigen::VectorXd x = calibrating_.state();
+  Eigen::MatrixXd p = calibrating_.covariance();
+  const std::optional<RangeCalibrationIndex> added = calibration_.add(beacon_id, x, p);
+  if (!added) return {};
+  calibrating_ = Ekf<Eigen::Dynamic>(StateSpace<Eigen::Dynamic>::with_pose({}, x.size()));
+  calibrating_.reset(x, p);  // the old belief, finite, with a pair at its prior: accepted
+  return *added;
+}
+
+void RangeEkf::calibration_to_prior(bool values) {
+  Eigen::VectorXd x = calibrating_.state();
+  Eigen::MatrixXd p = calibrating_.covariance();
+  calibration_.to_prior(x, p, values);
+  calibrating_.reset(x, p);
+}
+
+std::vector<Estimator::StateValue> RangeEkf::state_values() const {
+  if (!calibration_.enabled()) return {};
+  std::vector<StateValue> out = calibration_.values(calibrating_.state(), calibrating_.covariance());
+  out.push_back({"range_calibration_resets", static_cast<double>(calibration_resets_), 0.0});
+  out.push_back({"range_calibration_uncalibrated_beacons", static_cast<double>(calibration_.uncalibrated_beacons()), 0.0});
   return out;
 }
 

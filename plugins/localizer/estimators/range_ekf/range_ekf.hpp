@@ -5,6 +5,8 @@
 // window of ranges, each moved to the current pose through the dead-reckoned odometry, once the
 // fix is unambiguous and certain enough. Watched for divergence over the recent ranges: a pose
 // they contradict is degraded and, when a global fix confirms it is wrong, re-initialized.
+// With range_calibration 1 or 2 the ranges' scale and bias are estimated with the pose
+// (range_calibration.hpp): the state grows to [x, y, yaw, scale, bias, ...].
 #include <deque>
 #include <optional>
 
@@ -13,6 +15,7 @@
 #include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/filters/ekf.hpp"
 #include "beaconloc/core/solvers/range_pose_solver.hpp"
+#include "range_ekf/range_calibration.hpp"
 
 namespace beaconloc {
 
@@ -41,6 +44,12 @@ struct RangeEkfParameters {
   // chance of 3e-4 (at 5 %) per window, while a pose metres off meets it within 6-9 ranges.
   int divergence_window_ranges = 20;
   int divergence_gated_ranges = 6;
+  // The ranging system's calibration in the state: 0 none (ranges as the decoder gives them),
+  // 1 one scale and bias shared by every beacon, 2 one pair per beacon. The prior sigmas are the
+  // sensor's tolerance: a scale of 1 +- range_scale_sigma, a bias of 0 +- range_bias_sigma_m.
+  int range_calibration = 0;
+  double range_scale_sigma = 0.1;
+  double range_bias_sigma_m = 0.5;
 
   static RangeEkfParameters from(const EstimatorConfig& config);
 };
@@ -54,10 +63,12 @@ class RangeEkf final : public EstimatorBase {
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<RangeEkf>(*this); }
   // Re-initializations from a global fix that contradicted a suspect pose.
   std::uint64_t divergence_reinitializations() const { return divergence_reinitializations_; }
+  // The ranges' scale and bias with their sigmas, when calibrated (range_calibration.hpp).
+  std::vector<StateValue> state_values() const override;
 
  private:
   RangeEkf(const EstimatorConfig& config, const RangeEkfParameters& params);
-  PoseBelief pose_belief() const override { return {ekf_.state(), ekf_.covariance()}; }
+  PoseBelief pose_belief() const override;
   StartupWait waiting_for() const override { return waiting_for_; }
   bool place(const Pose2& pose_map_base, const Cov3& covariance) override;
   bool suspect() const override { return suspect_; }
@@ -74,6 +85,9 @@ class RangeEkf final : public EstimatorBase {
     Cov3 covariance = Cov3::Identity();
     StartupWait why_not;
     std::vector<RangeObservation> observations;  // the window's ranges after the echo screen
+    // With the calibration in the state: d pose / d calibration (3 x the calibration's size),
+    // how the fix moves with the scales and biases its ranges were read back with.
+    Eigen::MatrixXd calibration_sensitivity;
     double variance_factor = 1.0;                // the fix's cost per degree of freedom, when above 1
   };
   struct RangeOutcome {
@@ -85,11 +99,31 @@ class RangeEkf final : public EstimatorBase {
   bool attempt_due(StampNs newest_range_ns) const;
   void try_initialize();
   void watch_divergence(const RangeOutcome& outcome);
-  void start_from(const Pose2& pose, const Cov3& covariance, StampNs stamp_ns);
+  void start_from(const WindowFix& fix, StampNs stamp_ns);
+  // Every beacon of the window's pair in the state, before a fix reads their ranges back.
+  void calibrate_window_beacons();
 
   ReceiverArray receivers_;
   RangeEkfParameters params_;
+  // The filter in use: on the pose alone, or on the pose and the calibration (its size grows as
+  // beacons are first heard). f(filter) on the one in use.
+  template <class F>
+  decltype(auto) with_filter(F&& f) {
+    return calibration_.enabled() ? f(calibrating_) : f(ekf_);
+  }
+  template <class F>
+  decltype(auto) with_filter(F&& f) const {
+    return calibration_.enabled() ? f(calibrating_) : f(ekf_);
+  }
+  // The beacon's scale and bias, put in the state at the prior when first heard; none (the range
+  // as it is) beyond RangeCalibrationStates::kMaxPairs.
+  RangeCalibrationIndex calibration_of(std::uint32_t beacon_id);
+  // The calibration back to its prior: its values too (values), or its covariance alone.
+  void calibration_to_prior(bool values);
+  std::uint64_t calibration_resets_ = 0;  // a scale left [kMinScale, kMaxScale]: started again
   Ekf<3> ekf_{pose_space()};
+  RangeCalibrationStates calibration_;
+  Ekf<Eigen::Dynamic> calibrating_{StateSpace<Eigen::Dynamic>::with_pose({}, RangeCalibrationStates::kPoseSize)};
   Pose2 odom_pose_ = Pose2::Zero();  // dead-reckoned, odometry frame
   // The newest ranges, in stamp order, within init_window_s and at most kMaxWindowRanges: 5 slots
   // a second, up to 8 receivers, the longest window (60 s) is 2400; a bus flooding ranges (any

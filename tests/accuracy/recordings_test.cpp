@@ -1,0 +1,114 @@
+// range_ekf on the real recordings of ../shared/datasets (skipped without them), DDS-free: the
+// replay fed straight into the decoder and localizer cores, as `beaconloc run --replay` wires
+// them, with the README's settings. Issue 18's acceptance on them:
+//  - TUC Labyrinth, full 933 s, the ranges' scale and bias learnt online (range_calibration 1):
+//    position RMS <= 0.070 m (libRSF's self-tuning mixture gets 0.074 m), NEES in band >= 0.85;
+//  - CMU Plaza 1 and 2 without --range-scale: the scale learnt within 1 % of the 1.069 the
+//    datasets' README measured against ground truth.
+// The README has the commands and figures; docs/range-calibration.md what they mean.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+
+#include "beaconloc/core/estimator_parameters.hpp"
+#include "evaluation.hpp"
+#include "localizer_core.hpp"
+#include "offline_run.hpp"
+#include "replay/replay_source.hpp"
+
+namespace beaconloc {
+namespace {
+
+const std::string kShared = std::string(BEACONLOC_SOURCE_DIR) + "/../shared/datasets";
+
+struct ReplayRun {
+  Metrics metrics;
+  std::map<std::string, Estimator::StateValue> state;  // the newest of each value
+};
+
+ReplayRun replay(const std::string& path, const TofDecoderConfig& decoding, const ReplayOptions& options,
+                 const std::vector<std::string>& parameters) {
+  ReplaySource source(path, options);
+  TofDecoder decoder(decoding);
+  decoder.set_beacon_map(source.beacon_map());
+  EstimatorConfig config;
+  config.receivers = source.receivers();
+  config.parameters = parse_estimator_parameters(parameters, "parameter");
+  LocalizerCore localizer("range_ekf", config);
+  localizer.set_beacon_map(source.beacon_map());
+  std::vector<SourceEvent> events;
+  source.advance(source.last_stamp_ns(), events);
+  TruthTrack truth;
+  std::vector<EstimateRow> rows;
+  ReplayRun run;
+  for (const SourceEvent& e : events) {
+    if (e.has_truth) truth.add(e.stamp_ns, e.truth_map_base, e.truth_has_yaw);
+    std::optional<EstimatorInput> input = estimator_input("robot", e, decoder, localizer.beacon_input());
+    if (!input) continue;
+    const bool odometry = is_odometry(*input);
+    const auto out = localizer.on_input("robot", std::move(*input));
+    if (!out || !odometry) continue;
+    rows.push_back({"robot", out->estimate, "range_ekf"});
+    for (const auto& v : out->state) run.state[v.name] = v;
+  }
+  run.metrics = evaluate(truth, rows);
+  return run;
+}
+
+TEST(Recordings, TucLabyrinthWithTheRangesCalibratedOnline) {
+  const std::string path = kShared + "/tuc_labyrinth_uwb/replay/full_933s";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  TofDecoderConfig decoding;
+  decoding.max_range_m = 10.0;
+  decoding.range_sigma_m = 0.15;
+  const ReplayRun r = replay(path, decoding, {}, {"init_window_s=5", "range_calibration=1"});
+  ASSERT_GT(r.metrics.samples, 7000u);
+  ASSERT_TRUE(r.state.count("range_scale") && r.state.count("range_bias_m"));
+  std::printf("TUC Labyrinth full: position RMS %.4f m, NEES in band %.2f, scale %.4f +- %.4f, bias %.3f +- %.3f m\n",
+              r.metrics.position_rms_m, r.metrics.nees_in_band_fraction, r.state.at("range_scale").value,
+              r.state.at("range_scale").sigma, r.state.at("range_bias_m").value, r.state.at("range_bias_m").sigma);
+  EXPECT_LE(r.metrics.position_rms_m, 0.070);
+  EXPECT_GE(r.metrics.nees_in_band_fraction, 0.85);
+  // Without the calibration, as before issue 18: 0.135 m, its covariance too small.
+  const ReplayRun plain = replay(path, decoding, {}, {"init_window_s=5"});
+  EXPECT_GT(plain.metrics.position_rms_m, 1.5 * r.metrics.position_rms_m);
+}
+
+TEST(Recordings, CmuPlazaScaleLearntWithoutBeingGivenIt) {
+  int replayed = 0;
+  for (const char* name : {"plaza1", "plaza2"}) {
+    const std::string path = kShared + "/cmu_plaza_gpslam/replay/" + name;
+    if (!std::filesystem::exists(path)) continue;
+    ++replayed;
+    TofDecoderConfig decoding;
+    decoding.max_range_m = 150.0;
+    decoding.range_sigma_m = 1.0;
+    ReplayOptions options;
+    options.odometry_k_v_m = 0.002;
+    const ReplayRun r = replay(path, decoding, options,
+                               {"init_window_s=20", "max_odometry_gap_s=0.5", "init_max_position_sigma_m=2",
+                                "init_max_yaw_sigma_rad=0.5", "range_calibration=1"});
+    ASSERT_GT(r.metrics.samples, 3000u) << name;
+    ASSERT_TRUE(r.state.count("range_scale")) << name;
+    const Estimator::StateValue& scale = r.state.at("range_scale");
+    std::printf("%s: position RMS %.3f m, NEES in band %.2f, scale %.4f +- %.4f (the datasets' README: 1.069)\n", name,
+                r.metrics.position_rms_m, r.metrics.nees_in_band_fraction, scale.value, scale.sigma);
+    EXPECT_LT(std::abs(scale.value / 1.069 - 1.0), 0.01) << name;
+    // Issue 18 asks 0.45 m; it is not met yet (docs/range-calibration.md). Asserted: the
+    // calibration learnt brings the run to within 10 % of what the scale handed in gives.
+    TofDecoderConfig given = decoding;
+    given.range_scale = 1.069;
+    const ReplayRun handed_in = replay(path, given, options,
+                                       {"init_window_s=20", "max_odometry_gap_s=0.5", "init_max_position_sigma_m=2",
+                                        "init_max_yaw_sigma_rad=0.5"});
+    std::printf("%s with --range-scale 1.069: position RMS %.3f m\n", name, handed_in.metrics.position_rms_m);
+    EXPECT_LT(r.metrics.position_rms_m, 1.1 * handed_in.metrics.position_rms_m) << name;
+  }
+  if (replayed == 0) GTEST_SKIP() << "no CMU Plaza recording beside the repository";
+}
+
+}  // namespace
+}  // namespace beaconloc
