@@ -56,6 +56,21 @@ void ChildProcess::signal(int sig) {
   if (!status_ && pid_ > 0) ::kill(pid_, sig);
 }
 
+bool ChildProcess::stop(std::chrono::milliseconds timeout) {
+  if (status_ || pid_ <= 0 || ::kill(pid_, SIGSTOP) != 0) return false;
+  const auto end = std::chrono::steady_clock::now() + scaled(timeout);
+  while (std::chrono::steady_clock::now() < end) {
+    siginfo_t info{};
+    // WSTOPPED without WEXITED: only the stop is reported (and consumed); an exit stays for wait().
+    if (::waitid(P_PID, static_cast<id_t>(pid_), &info, WSTOPPED | WNOHANG) == 0 && info.si_pid == pid_) {
+      return info.si_code == CLD_STOPPED;
+    }
+    if (::kill(pid_, 0) != 0) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return false;
+}
+
 namespace {
 
 // AddressSanitizer, LeakSanitizer and UndefinedBehaviorSanitizer reports (the build of

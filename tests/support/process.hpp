@@ -29,6 +29,11 @@ class ChildProcess {
 
   pid_t pid() const { return pid_; }
   void signal(int sig);
+  // Stops the child (SIGSTOP) and returns once every one of its threads has stopped (the kernel
+  // reports the group stop to this parent), true; false if that is not seen within the timeout
+  // (scaled() by kTimeScale) or the child has ended. kill() only queues the signal: a thread
+  // running on another core goes on for a moment after it returns.
+  bool stop(std::chrono::milliseconds timeout);
   // The exit code, or 128 + signal; nullopt on timeout (scaled() by kTimeScale). A sanitizer
   // report in the child's output is a test failure whatever the exit code.
   std::optional<int> wait(std::chrono::milliseconds timeout);
