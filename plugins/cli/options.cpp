@@ -31,7 +31,13 @@ OptionSet source_option_set(SourceChoice& s) {
             "wheel base used to express a recording's (v, omega) as wheel velocities",
             real_in(0.0, kMaxWheelBaseM, kOpen))
       .real("--replay-odometry-k-v", s.replay.odometry_k_v_m,
-            "odometry noise reported with replayed samples: sigma_v^2 = k_v |v| / dT per wheel", real_in(0.0, 1.0))
+            "odometry distance noise reported with replayed samples: sigma^2 = k_v |v| / dT, per wheel when "
+            "the recording has half_track_m, else on v",
+            real_in(0.0, ReplayOptions::kMaxOdometryKvM))
+      .real("--replay-heading-arw", s.replay.odometry_heading_arw_rad_per_sqrt_s,
+            "heading rate noise of a recording without wheels (no half_track_m): sigma_omega^2 = N^2 / dT, "
+            "N in rad/sqrt(s)",
+            real_in(0.0, ReplayOptions::kMaxHeadingArwRadPerSqrtS))
       .texts("--fault", s.faults,
              "inject a fault into the simulation (repeatable): beacon_dies=ID@T, tof_outage=FROM:TO "
              "(seconds), echoes=P");

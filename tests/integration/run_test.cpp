@@ -255,8 +255,8 @@ TEST_F(Run, ReplaysTheSharedRecordings) {
         "range_calibration=1"},
        0.5},
       {"cmu_plaza_gpslam/replay/plaza1",
-       {"--max-range-m", "150", "--range-sigma-m", "1.0", "--replay-odometry-k-v", "0.002", "--param",
-        "init_window_s=20", "--param", "max_odometry_gap_s=0.5", "--param", "init_max_position_sigma_m=2", "--param",
+       {"--max-range-m", "150", "--range-sigma-m", "1.0", "--replay-odometry-k-v", "0.001", "--replay-heading-arw",
+        "0.014", "--param", "init_window_s=20", "--param", "max_odometry_gap_s=0.5", "--param", "init_max_position_sigma_m=2", "--param",
         "init_max_yaw_sigma_rad=0.5", "--param", "range_calibration=1"},
        2.0}};
   int replayed = 0;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
 
 namespace beaconloc {
 namespace {
@@ -57,6 +58,7 @@ TEST(Ekf, GatesOutliersAndLeavesTheStateAlone) {
   const auto result = ekf.update(LinearModel<1, 3>(h, r), Vec<1>(1.0), 10.83);
   EXPECT_EQ(result.outcome, FilterOutcome::kGated);
   EXPECT_NEAR(result.nis, 1.0 / 0.02, 1e-9);
+  EXPECT_NEAR(result.log_det_s, std::log(0.02), 1e-12);  // S = P + R, a scalar: its own factor
   EXPECT_EQ(ekf.state(), Eigen::Vector3d::Zero());
 }
 

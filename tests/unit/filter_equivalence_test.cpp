@@ -142,8 +142,12 @@ void expect_textbook_on_linear_model(Filter filter, double tol) {
     ASSERT_TRUE(filter.state().isApprox(kf.x, tol)) << k << "\n" << filter.state() << "\n" << kf.x;
     ASSERT_TRUE(filter.covariance().isApprox(kf.p, tol)) << k;
     const Vec<2> z = h * kf.x + Vec<2>(noise(rng), noise(rng));
+    const Mat<2, 2> s = h * kf.p * h.transpose() + r;  // the innovation's covariance, before the update
     kf.update(h, r, z);
-    ASSERT_TRUE(filter.update(model, z).applied());
+    const UpdateResult updated = filter.update(model, z);
+    ASSERT_TRUE(updated.applied());
+    // The innovation's likelihood needs log det S (UpdateResult::log_det_s): the LDLT's here.
+    EXPECT_NEAR(updated.log_det_s, std::log(s.determinant()), 10 * tol) << k;
     ASSERT_TRUE(filter.state().isApprox(kf.x, tol)) << k << "\n" << filter.state() << "\n" << kf.x;
     ASSERT_TRUE(filter.covariance().isApprox(kf.p, tol)) << k;
   }

@@ -48,7 +48,8 @@ TEST(OptionSets, WhatACommandParsedItsChildParsesBackBitForBit) {
   const std::string scenario = std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/default.yaml";
   Settings parent;
   parent.parse({"--domain", "17", "--participant-profile", "robot.profile", "--scenario", scenario,
-                "--replay-wheel-base-m", "0.12345678901234567", "--replay-odometry-k-v", "3.3e-4", "--fault",
+                "--replay-wheel-base-m", "0.12345678901234567", "--replay-odometry-k-v", "3.3e-4", "--replay-heading-arw",
+                "0.0123456789012345678", "--fault",
                 "echoes=0.1", "--fault", "beacon_dies=2@5", "--robot", "r7", "--duration-s",
                 "12.345678901234567", "--speed", "2.5", "--seed", "18446744073709551615", "--truth-out",
                 "/tmp/truth.csv", "--min-range-m", "0.1", "--max-range-m", "7.7777777777777777",
@@ -62,6 +63,9 @@ TEST(OptionSets, WhatACommandParsedItsChildParsesBackBitForBit) {
   EXPECT_TRUE(child.source.replay_dir.empty());
   EXPECT_EQ(child.source.replay.wheel_base_m, parent.source.replay.wheel_base_m);
   EXPECT_EQ(child.source.replay.odometry_k_v_m, 3.3e-4);
+  EXPECT_EQ(child.source.replay.odometry_heading_arw_rad_per_sqrt_s,
+            parent.source.replay.odometry_heading_arw_rad_per_sqrt_s);
+  EXPECT_EQ(parent.source.replay.odometry_heading_arw_rad_per_sqrt_s, 0.0123456789012345678);
   EXPECT_EQ(child.source.faults, (std::vector<std::string>{"echoes=0.1", "beacon_dies=2@5"}));
   EXPECT_EQ(child.gateway.robot_id, "r7");
   EXPECT_EQ(child.gateway.duration_s, 12.345678901234567);

@@ -282,6 +282,48 @@ TEST(Replay, AByteOrderMarkIsAnEncodingMarkAndAColumnNamedTwiceIsAnError) {
   }
 }
 
+// The noise reported with a row: a recording without wheels has it on (v, omega), mapped onto
+// the wheel speeds so that it comes back the same for any wheel base (the filters' eq. 16 map:
+// v = (v_R + v_L) / 2, omega = (v_R - v_L) / B); one with the robot's wheels has it per wheel.
+TEST(Replay, OdometryNoiseIsTheSensorsWhateverWheelBaseExpressesIt) {
+  const std::string without_wheels =
+      recording("replay_noise_v_omega", {{"odom.csv", "t_s,dt_s,v_mps,omega_radps\n1.0,0.2,0.8,0.3\n"}});
+  for (const double wheel_base_m : {0.3, 0.5, 4.0}) {
+    ReplayOptions options;
+    options.wheel_base_m = wheel_base_m;
+    options.odometry_k_v_m = 0.002;
+    options.odometry_heading_arw_rad_per_sqrt_s = 0.01;
+    ReplaySource replay(without_wheels, options);
+    const auto events = everything(replay);
+    ASSERT_EQ(events.size(), 1u);
+    const OdometrySample& o = events[0].odometry;
+    Eigen::Matrix2d to_v_omega;  // [v, omega] = T [v_R, v_L]
+    to_v_omega << 0.5, 0.5, 1.0 / o.wheel_base_m, -1.0 / o.wheel_base_m;
+    const Eigen::Matrix2d c = to_v_omega * o.wheel_velocity_covariance * to_v_omega.transpose();
+    EXPECT_NEAR(c(0, 0), 0.002 * 0.8 / 0.2, 1e-15) << "B " << wheel_base_m;
+    EXPECT_NEAR(c(1, 1), 0.01 * 0.01 / 0.2, 1e-15) << "B " << wheel_base_m;
+    EXPECT_NEAR(c(0, 1), 0.0, 1e-15) << "B " << wheel_base_m;
+    EXPECT_EQ(o.wheel_velocity_covariance(0, 1), o.wheel_velocity_covariance(1, 0));  // exactly symmetric
+  }
+  for (const double bad : {-1e-3, 2.0, std::nan("")}) {
+    ReplayOptions options;
+    options.odometry_heading_arw_rad_per_sqrt_s = bad;
+    EXPECT_THROW(ReplaySource(without_wheels, options), ReplayError) << bad;
+    options = ReplayOptions();
+    options.odometry_k_v_m = bad;
+    EXPECT_THROW(ReplaySource(without_wheels, options), ReplayError) << bad;
+  }
+  const std::string with_wheels = recording(
+      "replay_noise_wheels", {{"odom.csv", "t_s,dt_s,v_mps,omega_radps,half_track_m\n1.0,0.2,0.8,0.3,0.1\n"}});
+  ReplayOptions options;
+  options.odometry_k_v_m = 0.002;
+  ReplaySource replay(with_wheels, options);
+  const OdometrySample o = everything(replay)[0].odometry;
+  EXPECT_DOUBLE_EQ(o.wheel_velocity_covariance(0, 0), 0.002 * (0.8 + 0.3 * 0.1) / 0.2);
+  EXPECT_DOUBLE_EQ(o.wheel_velocity_covariance(1, 1), 0.002 * (0.8 - 0.3 * 0.1) / 0.2);
+  EXPECT_EQ(o.wheel_velocity_covariance(0, 1), 0.0);
+}
+
 TEST(Replay, SharedRecordingsLoad) {
   // Plaza 1 files two ranges twice (lines 2868 and 2892 repeat the stamp and beacon of lines 2767
   // and 2791, in a block filed 64 s late, with other values): the second of each is refused.

@@ -62,6 +62,12 @@ ReplaySource::ReplaySource(const std::string& directory, ReplayOptions options)
     : directory_(directory), options_(options) {
   if (!(options_.wheel_base_m > 0.0 && options_.wheel_base_m <= kMaxWheelBaseM))
     throw ReplayError("replay wheel base must be in (0, " + std::to_string(kMaxWheelBaseM) + "] m");
+  if (!(options_.odometry_k_v_m >= 0.0 && options_.odometry_k_v_m <= ReplayOptions::kMaxOdometryKvM))
+    throw ReplayError("replay odometry k_v must be in [0, " + std::to_string(ReplayOptions::kMaxOdometryKvM) + "] m");
+  if (!(options_.odometry_heading_arw_rad_per_sqrt_s >= 0.0 &&
+        options_.odometry_heading_arw_rad_per_sqrt_s <= ReplayOptions::kMaxHeadingArwRadPerSqrtS))
+    throw ReplayError("replay heading angle random walk must be in [0, " +
+                      std::to_string(ReplayOptions::kMaxHeadingArwRadPerSqrtS) + "] rad/sqrt(s)");
   load_beacons(directory + "/beacons.csv");
   load_odometry(directory + "/odom.csv");
   // A recording hears its beacons one way: ranges, or pulse arrivals without a firing time.
@@ -94,6 +100,27 @@ void ReplaySource::load_beacons(const std::string& path) {
   } catch (const CsvError& e) {
     throw ReplayError(e.what());
   }
+}
+
+Eigen::Matrix2d ReplaySource::odometry_covariance(bool own_wheels, double v_mps, double right_mps, double left_mps,
+                                                  double dt_s, double half_track_m) const {
+  if (own_wheels) {
+    return Eigen::Vector2d(options_.odometry_k_v_m * std::abs(right_mps) / dt_s,
+                           options_.odometry_k_v_m * std::abs(left_mps) / dt_s)
+        .asDiagonal();
+  }
+  // Noise on (v, omega), independent, carried exactly by the wheel speeds [v_R, v_L] = A [v, omega]
+  // that express them: cov = A diag(sigma_v^2, sigma_omega^2) A^T, A = [[1, b], [1, -b]], b the
+  // half track used. The filters map it back (seed 000 eq. 16) to the same (v, omega) noise for
+  // any b: the made-up wheel base no longer decides how much the heading is trusted.
+  // Written out, so that it is exactly symmetric.
+  const double arw = options_.odometry_heading_arw_rad_per_sqrt_s;
+  const double speed_variance = options_.odometry_k_v_m * std::abs(v_mps) / dt_s;
+  const double rate_variance_in_wheel_speed = half_track_m * half_track_m * arw * arw / dt_s;
+  Eigen::Matrix2d c;
+  c << speed_variance + rate_variance_in_wheel_speed, speed_variance - rate_variance_in_wheel_speed,
+      speed_variance - rate_variance_in_wheel_speed, speed_variance + rate_variance_in_wheel_speed;
+  return c;
 }
 
 void ReplaySource::load_odometry(const std::string& path) {
@@ -159,9 +186,7 @@ void ReplaySource::load_odometry(const std::string& path) {
     e.odometry.wheel_base_m = 2.0 * half_track;
     e.odometry.wheel_velocity_right_mps = right;
     e.odometry.wheel_velocity_left_mps = left;
-    e.odometry.wheel_velocity_covariance.diagonal()
-        << options_.odometry_k_v_m * std::abs(e.odometry.wheel_velocity_right_mps) / dt,
-        options_.odometry_k_v_m * std::abs(e.odometry.wheel_velocity_left_mps) / dt;
+    e.odometry.wheel_velocity_covariance = odometry_covariance(has_half_track, v, right, left, dt, half_track);
     events_.push_back(e);
   }
 }

@@ -27,12 +27,24 @@ class ReplayError : public std::runtime_error {
 };
 
 struct ReplayOptions {
+  // Beyond these the noise says nothing (a wheel speed sigma of 1 m/s at 1 m/s over 1 s; a
+  // heading sigma of 1 rad after 1 s): refused.
+  static constexpr double kMaxOdometryKvM = 1.0;
+  static constexpr double kMaxHeadingArwRadPerSqrtS = 1.0;
   // The recording gives (v, omega); the Odometry topic carries wheel velocities. Any wheel base
   // converts exactly; a half_track_m column, when present, gives the robot's own.
   double wheel_base_m = 0.5;
-  // Odometry noise reported with each sample (seed 000's model, sigma_v^2 = k_v |v| / dT per
-  // wheel): recordings carry none.
+  // Odometry noise reported with each sample: recordings carry none. Distance: seed 000's model,
+  // sigma^2 = k_v |v| / dT, per wheel when the recording gives the robot's own wheels
+  // (half_track_m), else on the speed v.
   double odometry_k_v_m = 4e-4;
+  // Heading, for a recording without wheels (its omega from whatever the robot measured it
+  // with): white rate noise, sigma_omega^2 = N^2 / dT, N the heading sensor's angle random walk
+  // in rad/sqrt(s). The default is the value the CMU Plaza recordings (the one such vehicle we
+  // have) fit best without ground truth: the smallest mean range_innovation_nll_nats of
+  // range_ekf over both (scripts/replay-noise-fit.sh, docs/replay-odometry-noise.md). With
+  // wheels, the heading noise follows from theirs.
+  double odometry_heading_arw_rad_per_sqrt_s = 0.014;
   // Ranges travel as TOF: tof = range / c(T), with this temperature reported alongside, so the
   // decoder recovers each range exactly.
   double reference_temperature_c = 20.0;
@@ -65,6 +77,9 @@ class ReplaySource final : public Source {
  private:
   void load_beacons(const std::string& path);
   void load_odometry(const std::string& path);
+  // The wheel speeds' covariance reported with a row (ReplayOptions: the noise models).
+  Eigen::Matrix2d odometry_covariance(bool own_wheels, double v_mps, double right_mps, double left_mps, double dt_s,
+                                      double half_track_m) const;
   void load_ranges(const std::string& path);
   void load_pulses(const std::string& path);
   void load_truth(const std::string& path);

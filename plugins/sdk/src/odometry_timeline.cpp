@@ -9,10 +9,13 @@ namespace beaconloc {
 namespace {
 // Symmetric, positive semi-definite (non-negative variances and determinant), and no variance
 // beyond the square of the largest speed there is (a standard deviation over 10 m/s says nothing).
+// A rank-one covariance (the replay's standing robot: noise on the turn rate only) has a
+// determinant of exactly 0, which rounding (a fused multiply-add) can make a hair negative: a
+// correlation beyond 1 by rounding only (1e-12 relative) is still accepted.
 bool valid_covariance(const Eigen::Matrix2d& c) {
   const double max_variance = kMaxWheelSpeedMps * kMaxWheelSpeedMps;
   return c(0, 1) == c(1, 0) && c(0, 0) >= 0.0 && c(1, 1) >= 0.0 && c(0, 0) <= max_variance &&
-         c(1, 1) <= max_variance && c(0, 0) * c(1, 1) - c(0, 1) * c(1, 0) >= 0.0;
+         c(1, 1) <= max_variance && c(0, 0) * c(1, 1) - c(0, 1) * c(1, 0) >= -1e-12 * c(0, 0) * c(1, 1);
 }
 }  // namespace
 

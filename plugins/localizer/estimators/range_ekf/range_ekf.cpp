@@ -71,6 +71,9 @@ RangeEkf::RangeEkf(const EstimatorConfig& config, const RangeEkfParameters& para
 
 InputResult RangeEkf::predict(const OdometrySample& o) {
   const OdometryTimeline::Step step = advance(o);
+  // The time line now stands at this sample (integrated, its anchor, or re-anchored after a
+  // gap): its wheel speeds are the robot's newest.
+  if (step.result.accepted || step.result.rejection == Rejection::kOdometryGap) last_odometry_ = o;
   if (!step.integrate) return step.result;
   const double dt_s = step.dt_s;
   odom_pose_ = predict_diff_drive(odom_pose_, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps,
@@ -97,7 +100,8 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
   }
 
   // Every good range joins the window a global fix is computed from.
-  window_.push_back({r, odom_pose_});
+  const Pose2 odom_pose_at_range = odom_pose_at(r.stamp_ns);
+  window_.push_back({r, odom_pose_at_range});
   while (!window_.empty() && (window_.front().range.stamp_ns < r.stamp_ns - s_to_ns(params_.init_window_s) ||
                               window_.size() > kMaxWindowRanges)) {
     window_.pop_front();
@@ -106,19 +110,39 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
     try_initialize();
     return InputResult::ok();
   }
-  return fuse(r);
+  return fuse(r, odom_pose_at_range);
 }
 
-// The range is fused at the filter's current time (the newest odometry stamp); pushed in stamp
-// order, the pulse arrived within one odometry period of it (<= 10 ms, 3.4 mm at 0.34 m/s). The
-// localizer pushes in stamp order however late a range arrives (core/out_of_sequence_fusion).
-InputResult RangeEkf::fuse(const RangeMeasurement& r) {
+Pose2 RangeEkf::odom_pose_at(StampNs stamp_ns) const {
+  if (!last_odometry_ || !now_ns()) return odom_pose_;
+  const double lag_s = ns_to_s(stamp_ns - *now_ns());
+  if (std::abs(lag_s) > params_.max_odometry_gap_s) return odom_pose_;
+  const OdometrySample& o = *last_odometry_;
+  return predict_diff_drive(odom_pose_, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps, o.wheel_base_m, lag_s)
+      .pose;
+}
+
+// The range is fused at the filter's current time (the newest odometry stamp, now_ns()); pushed
+// in stamp order (the localizer does, however late a range arrives: core/out_of_sequence_fusion),
+// its pulse arrived after that odometry and before the next one: up to one odometry period
+// later (10 ms at 100 Hz, 0.2 s on a recording with 5 Hz odometry, 0.2 m at 1 m/s). The receiver
+// is taken where the robot was at the range's stamp: moved, in the frame of the pose now, along
+// the newest wheel speeds over the lag (eq. 14 with dT = the lag). The lag's own uncertainty
+// (the speeds' noise times the lag) is left out: 1 mm at 100 Hz.
+InputResult RangeEkf::fuse(const RangeMeasurement& r, const Pose2& odom_pose_at_range) {
   const Beacon& beacon = *map().find(r.beacon_id);
-  const RangeModel model(receivers_.receivers_base_m[r.receiver_id], receivers_.receiver_height_m,
-                         beacon.position_map_m, r.variance_m2, PoseIndex{},
+  const Pose2 then_in_now = between(odom_pose_, odom_pose_at_range);
+  const RangeModel model(transform_point(then_in_now, receivers_.receivers_base_m[r.receiver_id]),
+                         receivers_.receiver_height_m, beacon.position_map_m, r.variance_m2, PoseIndex{},
                          calibration_.enabled() ? calibration_of(r.beacon_id) : RangeCalibrationIndex{});
   const UpdateResult result = with_filter(
       [&](auto& filter) { return filter.update(model, RangeModel::Vector(r.range_m), params_.nis_gate); });
+  static_assert(RangeModel::kSize == 1, "log 2 pi is the constant of a 1-D Gaussian");
+  if (result.outcome == FilterOutcome::kApplied || result.outcome == FilterOutcome::kGated) {
+    const double nis = result.outcome == FilterOutcome::kGated ? params_.nis_gate : result.nis;
+    innovation_nll_sum_ += 0.5 * (nis + result.log_det_s + std::log(2.0 * M_PI));
+    ++innovations_;
+  }
   switch (result.outcome) {
     case FilterOutcome::kApplied:
       consecutive_gated_ = 0;
@@ -407,8 +431,12 @@ void RangeEkf::calibration_to_prior(bool values) {
 }
 
 std::vector<Estimator::StateValue> RangeEkf::state_values() const {
-  if (!calibration_.enabled()) return {};
-  std::vector<StateValue> out = calibration_.values(calibrating_.state(), calibrating_.covariance());
+  std::vector<StateValue> out;
+  if (innovations_ > 0) {
+    out.push_back({"range_innovation_nll_nats", innovation_nll_sum_ / static_cast<double>(innovations_), 0.0});
+  }
+  if (!calibration_.enabled()) return out;
+  for (const StateValue& v : calibration_.values(calibrating_.state(), calibrating_.covariance())) out.push_back(v);
   out.push_back({"range_calibration_resets", static_cast<double>(calibration_resets_), 0.0});
   out.push_back({"range_calibration_uncalibrated_beacons", static_cast<double>(calibration_.uncalibrated_beacons()), 0.0});
   return out;

@@ -63,7 +63,11 @@ class RangeEkf final : public EstimatorBase {
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<RangeEkf>(*this); }
   // Re-initializations from a global fix that contradicted a suspect pose.
   std::uint64_t divergence_reinitializations() const { return divergence_reinitializations_; }
-  // The ranges' scale and bias with their sigmas, when calibrated (range_calibration.hpp).
+  // range_innovation_nll_nats: the mean negative log-likelihood of the ranges' innovations so
+  // far (nats per range, ranges in metres; a truncated likelihood, see innovation_nll_sum_), a
+  // fit to the data that needs no ground truth: lower is better, and noise settings can be
+  // chosen by it (scripts/replay-noise-fit.sh). With the calibration, the ranges' scale and bias
+  // with their sigmas (range_calibration.hpp).
   std::vector<StateValue> state_values() const override;
 
  private:
@@ -94,7 +98,8 @@ class RangeEkf final : public EstimatorBase {
     bool gated;
     double nis;
   };
-  InputResult fuse(const RangeMeasurement& range);
+  // odom_pose_at_range: odom_pose_at(range.stamp_ns).
+  InputResult fuse(const RangeMeasurement& range, const Pose2& odom_pose_at_range);
   WindowFix window_fix() const;
   bool attempt_due(StampNs newest_range_ns) const;
   void try_initialize();
@@ -121,10 +126,21 @@ class RangeEkf final : public EstimatorBase {
   // The calibration back to its prior: its values too (values), or its covariance alone.
   void calibration_to_prior(bool values);
   std::uint64_t calibration_resets_ = 0;  // a scale left [kMinScale, kMaxScale]: started again
+  // The ranges' fit, without ground truth: the sum over the ranges fused or gated (while the
+  // filter has a pose) of their innovation's negative log-likelihood,
+  // 0.5 (nis + log S + log 2 pi), a gated one counted at the gate (a truncated likelihood: an
+  // echo weighs no more than a range at the gate).
+  double innovation_nll_sum_ = 0.0;
+  std::uint64_t innovations_ = 0;
   Ekf<3> ekf_{pose_space()};
   RangeCalibrationStates calibration_;
   Ekf<Eigen::Dynamic> calibrating_{StateSpace<Eigen::Dynamic>::with_pose({}, RangeCalibrationStates::kPoseSize)};
-  Pose2 odom_pose_ = Pose2::Zero();  // dead-reckoned, odometry frame
+  Pose2 odom_pose_ = Pose2::Zero();  // dead-reckoned, odometry frame, at now_ns()
+  // The newest sample the time line stands at (integrated, its anchor, or re-anchored after a gap).
+  std::optional<OdometrySample> last_odometry_;
+  // The dead-reckoned pose at stamp_ns: odom_pose_ moved along the newest wheel speeds over
+  // stamp_ns - now_ns() (either sign, at most max_odometry_gap_s; odom_pose_ beyond that).
+  Pose2 odom_pose_at(StampNs stamp_ns) const;
   // The newest ranges, in stamp order, within init_window_s and at most kMaxWindowRanges: 5 slots
   // a second, up to 8 receivers, the longest window (60 s) is 2400; a bus flooding ranges (any
   // number within the window's span) must not make each range's work grow without bound.

@@ -106,6 +106,43 @@ TEST(RangeEkf, RefusesBadInputWithATypedReason) {
   EXPECT_EQ(ekf->status(), PoseStatus::kInitializing);
 }
 
+// A recording's odometry at 5 Hz: each range is stamped 100 ms after the newest odometry sample,
+// when the robot driving at 1 m/s is 0.1 m further on. Fused where the robot was at its stamp,
+// exact ranges keep the pose exact; fused at the odometry's stamp they would pull it 0.1 m back.
+TEST(RangeEkf, ARangeBetweenTwoOdometrySamplesIsFusedWhereTheRobotWasAtItsStamp) {
+  const ReceiverArray receivers = ReceiverArray::on_circle(0.19, 3);
+  const BeaconMap map({{1, {0.0, 0.0, 2.5}, 0}, {2, {4.0, 0.0, 2.5}, 0}, {3, {2.0, 3.0, 2.5}, 0},
+                       {4, {2.0, -3.0, 2.5}, 0}});
+  EstimatorConfig config;
+  config.receivers = receivers;
+  config.parameters = {{"max_odometry_gap_s", 0.5}};
+  RangeEkf ekf(config);
+  ekf.set_beacon_map(map);
+  constexpr double kSpeedMps = 1.0;
+  constexpr StampNs kOdometryPeriodNs = 200'000'000;
+  const auto truth_at = [&](StampNs stamp_ns) { return Pose2(-1.0 + kSpeedMps * ns_to_s(stamp_ns), 0.5, 0.0); };
+  OdometrySample o;
+  o.wheel_base_m = 0.33;
+  o.wheel_velocity_right_mps = o.wheel_velocity_left_mps = kSpeedMps;
+  o.stamp_ns = 0;
+  ASSERT_TRUE(ekf.predict(o).accepted);
+  ASSERT_TRUE(ekf.reset(0, truth_at(0), 1e-6 * Cov3::Identity()).accepted);
+  double worst_error_m = 0.0;
+  for (int k = 0; k < 30; ++k) {  // 6 s, 6 m
+    const StampNs range_stamp_ns = o.stamp_ns + kOdometryPeriodNs / 2;
+    const Beacon& beacon = *map.find(1 + static_cast<std::uint32_t>(k % 4));
+    for (const RangeMeasurement& r : test_support::exact_ranges(truth_at(range_stamp_ns), receivers, beacon,
+                                                                range_stamp_ns)) {
+      ASSERT_TRUE(ekf.update(r).accepted) << "slot " << k;
+    }
+    o.stamp_ns += kOdometryPeriodNs;
+    ASSERT_TRUE(ekf.predict(o).accepted);
+    const Pose2 estimate = ekf.estimate()->pose_map_base;
+    worst_error_m = std::max(worst_error_m, (estimate.head<2>() - truth_at(o.stamp_ns).head<2>()).norm());
+  }
+  EXPECT_LT(worst_error_m, 2e-3);
+}
+
 TEST(RangeEkf, DegradesWithoutRangesAndRecoversWhenTheyReturn) {
   testing::OfflineStack stack(sim::default_scenario());
   PoseStatus at_8s = PoseStatus::kInitializing, at_20s = PoseStatus::kInitializing;
@@ -158,6 +195,32 @@ TEST(RangeEkf, APosePlacedMetresOffIsReinitializedFromTheBeaconsWithinThreeSlots
   EXPECT_EQ(robot.ekf_->divergence_reinitializations(), 1u);
   EXPECT_LT(robot.error_m(), 1e-3);
   EXPECT_EQ(robot.ekf_->status(), PoseStatus::kOk);
+}
+
+// range_innovation_nll_nats, the ranges' fit without ground truth: a truncated likelihood, so an
+// echo far beyond the gate weighs exactly what a range just beyond it does, and more than a
+// range that fits.
+TEST(RangeEkf, AnEchoWeighsOnTheFitNoMoreThanARangeAtTheGate) {
+  StandingUnderThreeBeacons robot;
+  for (int k = 0; k < 15; ++k) robot.slot();
+  ASSERT_TRUE(robot.ekf_->estimate());
+  const auto fit_after = [&](double range_error_m) {
+    const std::unique_ptr<Estimator> copy = robot.ekf_->clone();
+    RangeMeasurement r = test_support::exact_ranges(robot.truth_, robot.receivers_, *robot.map_.find(1),
+                                                    robot.stamp_ns_)[0];
+    r.range_m += range_error_m;
+    copy->update(r);
+    for (const Estimator::StateValue& v : copy->state_values()) {
+      if (v.name == "range_innovation_nll_nats") return v.value;
+    }
+    ADD_FAILURE() << "no range_innovation_nll_nats";
+    return 0.0;
+  };
+  // Ranges of sigma 1 cm, gated beyond 3.3 sigma (chi-square 1 dof, 99.9 %).
+  const double fits = fit_after(0.0), beyond_gate = fit_after(0.05), echo = fit_after(50.0);
+  EXPECT_TRUE(std::isfinite(fits));
+  EXPECT_LT(fits, beyond_gate);
+  EXPECT_EQ(beyond_gate, echo);
 }
 
 TEST(RangeEkf, ASuspectPoseIsDegradedUntilAGlobalFixSettlesIt) {

@@ -11,8 +11,9 @@
 // order they arrived. (A measurement stamped ahead of the newest odometry, within the horizon,
 // keeps its place when the odometry catches up, as in-order delivery would have it.) Estimators
 // see exactly the calls they would see in order, so each keeps its own rule for a measurement
-// between two odometry samples (range_ekf fuses it at the odometry stamp before it, ukf_lrf
-// holds it and fuses it at its own stamp).
+// between two odometry samples (range_ekf fuses it at the odometry stamp before it, with the
+// receiver moved to where the robot was at the range's stamp; ukf_lrf holds it and fuses it at
+// its own stamp).
 //
 // Only the verdict of a measurement's first application is returned (and counted by the
 // localizer); the verdicts of events re-applied during a replay are not counted again. What an

@@ -32,6 +32,7 @@ class Ekf : public LinearizedFilter<N> {
     result.outcome = u.outcome;
     if (!result.applied()) return result;
     result.nis = u.s->nis(u.innovation);
+    result.log_det_s = u.s->log_det();
     if (!(result.nis <= nis_gate)) {
       result.outcome = FilterOutcome::kGated;
       return result;

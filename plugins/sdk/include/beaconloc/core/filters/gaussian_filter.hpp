@@ -42,6 +42,14 @@ class InnovationFactor {
   }
   // The normalized innovation squared nu^T S^-1 nu.
   double nis(const Vec<M>& innovation) const { return innovation.dot(solve(innovation)); }
+  // log det S (S checked positive definite: its pivots are > 0).
+  double log_det() const {
+    if constexpr (M == 1) {
+      return std::log(factor_);
+    } else {
+      return factor_.vectorD().array().log().sum();
+    }
+  }
 
  private:
   std::conditional_t<M == 1, double, Eigen::LDLT<Mat<M, M>>> factor_{};  // s itself, or its LDLT

@@ -50,6 +50,7 @@ class HInfinityFilter : public LinearizedFilter<N> {
     }
     const Mat<M, N>& h = u.h;
     result.nis = u.s->nis(u.innovation);
+    result.log_det_s = u.s->log_det();
     if (!(result.nis <= nis_gate)) {
       result.outcome = FilterOutcome::kGated;
       return result;

@@ -56,6 +56,7 @@ class IteratedEkf : public LinearizedFilter<N> {
       }
       if (i == 0) {
         result.nis = s.nis(innovation);
+        result.log_det_s = s.log_det();
         if (!(result.nis <= nis_gate)) {
           result.outcome = FilterOutcome::kGated;
           return result;

@@ -20,6 +20,7 @@ const char* to_string(FilterOutcome outcome);
 struct UpdateResult {
   FilterOutcome outcome = FilterOutcome::kApplied;
   double nis = 0.0;    // normalized innovation squared nu^T S^-1 nu (at the prior)
+  double log_det_s = 0.0;  // log det S (at the prior): with nis, the innovation's likelihood
   int iterations = 0;  // linearizations made (1 for the EKF, up to the cap for the IEKF)
   bool applied() const { return outcome == FilterOutcome::kApplied; }
 };

@@ -229,6 +229,7 @@ class Ukf : public GaussianFilter<N> {
     }
     const Eigen::VectorXd innovation = model.residual(z, z_mean);
     result.nis = factor.nis(innovation);
+    result.log_det_s = factor.log_det();
     if (!(result.nis <= nis_gate)) {
       result.outcome = FilterOutcome::kGated;
       return result;
