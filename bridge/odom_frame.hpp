@@ -19,11 +19,12 @@ class OdomFrame {
   // Integrates wheel velocities (eq. 14 of seed 000) from the previous sample; the first sample
   // anchors the frame at the origin. Checked as the estimators check odometry (OdometryTimeline):
   // refused with their reasons (implausible_wheel_speed, out_of_order_odometry, ...), or
-  // implausible_odom_pose beyond a site's extent; a gap over kMaxIntegratedGapS is taken without
-  // integrating it (the frame stays where it was) and reported as odometry_gap.
+  // implausible_odom_pose beyond a site's extent; a gap (over kMaxIntegratedGapS, or what a
+  // slower sensor's own period allows: OdometryTimeline) is taken without integrating it (the
+  // frame stays where it was) and reported as odometry_gap.
   InputResult add_wheel_odometry(const OdometrySample& o);
-  // The estimators' default max_odometry_gap_s: a longer gap is not integrated.
-  static constexpr double kMaxIntegratedGapS = 0.2;
+  // The estimators' default max_odometry_gap_s.
+  static constexpr double kMaxIntegratedGapS = kDefaultMaxOdometryGapS;
   // A driver's own odom -> base pose (finite, within a site's extent), and its finite twist.
   bool add_odom_pose(StampNs stamp_ns, const Pose2& pose_odom_base, double v_mps, double omega_radps);
   // odom -> base at stamp_ns, interpolated between neighbours; nullopt outside the history.

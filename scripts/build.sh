@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Configures and builds one configuration: bash scripts/build.sh [Release|Debug|Asan]
-# into build/release, build/debug or build/asan. Asan is Debug (Eigen's assertions on) with
-# AddressSanitizer and UndefinedBehaviorSanitizer (BEACONLOC_SANITIZE, see CMakeLists.txt) and
-# without the benchmarks; run its tests with scripts/sanitizers.env in the environment.
-# Two compile jobs: ~330 MB each, sized for 2 cores.
+# into build/release, build/debug or build/asan. Asan is Debug (Eigen's assertions on) at -O1,
+# as the sanitizers recommend, with AddressSanitizer and UndefinedBehaviorSanitizer
+# (BEACONLOC_SANITIZE, see CMakeLists.txt) and without the benchmarks; run its tests with
+# scripts/sanitizers.env in the environment. Two compile jobs: ~330 MB each, sized for 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 type="${1:-Release}"

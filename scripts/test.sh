@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The test suite, three builds (warnings are errors in the first two):
-# 1. build/asan: Debug (Eigen's assertions on) with AddressSanitizer, LeakSanitizer and
+# 1. build/asan: Debug at -O1 (Eigen's assertions on) with AddressSanitizer, LeakSanitizer and
 #    UndefinedBehaviorSanitizer (scripts/build.sh Asan). Runs every unit test and every
 #    multi-process integration test (the Cyclone DDS peer included) with the runtime settings of
 #    scripts/sanitizers.env; any sanitizer report fails the run. Not Run.ReplaysTheSharedRecordings

@@ -4,8 +4,10 @@
 //  - TUC Labyrinth, full 933 s, the ranges' scale and bias learnt online (range_calibration 1):
 //    position RMS <= 0.070 m (libRSF's self-tuning mixture gets 0.074 m), NEES in band >= 0.85;
 //  - CMU Plaza 1 and 2 without --range-scale: the scale learnt within 1 % of the 1.069 the
-//    datasets' README measured against ground truth, position RMS <= 0.45 m, with the mower's
-//    odometry noise as fitted without ground truth (docs/replay-odometry-noise.md).
+//    datasets' README measured against ground truth, position RMS <= 0.45 m.
+// Each with the settings of its sensors alone (issue 18's item 6, docs/replay-odometry-noise.md):
+// the estimator's defaults, the ranges' calibration learnt, the noise the recording states (TUC's
+// 0.1 m per range) or, where it states none, the noise its data fit best without ground truth.
 // The README has the commands and figures; docs/range-calibration.md what they mean.
 #include <gtest/gtest.h>
 
@@ -64,8 +66,10 @@ TEST(Recordings, TucLabyrinthWithTheRangesCalibratedOnline) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
   TofDecoderConfig decoding;
   decoding.max_range_m = 10.0;
-  decoding.range_sigma_m = 0.15;
-  const ReplayRun r = replay(path, decoding, {}, {"init_window_s=5", "range_calibration=1"});
+  decoding.range_sigma_m = 0.1;
+  ReplayOptions options;
+  options.odometry_k_v_m = 0.0001;
+  const ReplayRun r = replay(path, decoding, options, {"range_calibration=1"});
   ASSERT_GT(r.metrics.samples, 7000u);
   ASSERT_TRUE(r.state.count("range_scale") && r.state.count("range_bias_m"));
   std::printf("TUC Labyrinth full: position RMS %.4f m, NEES in band %.2f, scale %.4f +- %.4f, bias %.3f +- %.3f m\n",
@@ -74,7 +78,7 @@ TEST(Recordings, TucLabyrinthWithTheRangesCalibratedOnline) {
   EXPECT_LE(r.metrics.position_rms_m, 0.070);
   EXPECT_GE(r.metrics.nees_in_band_fraction, 0.85);
   // Without the calibration, as before issue 18: 0.135 m, its covariance too small.
-  const ReplayRun plain = replay(path, decoding, {}, {"init_window_s=5"});
+  const ReplayRun plain = replay(path, decoding, options, {});
   EXPECT_GT(plain.metrics.position_rms_m, 1.5 * r.metrics.position_rms_m);
 }
 
@@ -86,13 +90,11 @@ TEST(Recordings, CmuPlazaScaleLearntWithoutBeingGivenIt) {
     ++replayed;
     TofDecoderConfig decoding;
     decoding.max_range_m = 150.0;
-    decoding.range_sigma_m = 1.0;
-    ReplayOptions options;  // the mower's odometry noise, fitted without ground truth (README)
-    options.odometry_k_v_m = 0.001;
+    decoding.range_sigma_m = 0.55;  // the radios' and the mower's noise, fitted without ground truth
+    ReplayOptions options;
+    options.odometry_k_v_m = 0.003;
     options.odometry_heading_arw_rad_per_sqrt_s = 0.014;
-    const ReplayRun r = replay(path, decoding, options,
-                               {"init_window_s=20", "max_odometry_gap_s=0.5", "init_max_position_sigma_m=2",
-                                "init_max_yaw_sigma_rad=0.5", "range_calibration=1"});
+    const ReplayRun r = replay(path, decoding, options, {"range_calibration=1"});
     ASSERT_GT(r.metrics.samples, 3000u) << name;
     ASSERT_TRUE(r.state.count("range_scale")) << name;
     const Estimator::StateValue& scale = r.state.at("range_scale");
@@ -100,14 +102,17 @@ TEST(Recordings, CmuPlazaScaleLearntWithoutBeingGivenIt) {
                 r.metrics.position_rms_m, r.metrics.nees_in_band_fraction, scale.value, scale.sigma);
     EXPECT_LT(std::abs(scale.value / 1.069 - 1.0), 0.01) << name;
     EXPECT_LE(r.metrics.position_rms_m, 0.45) << name;  // issue 18
-    // And the calibration learnt brings the run to within 10 % of what the scale handed in gives.
+    // And the calibration learnt brings the run to within 15 % of what the scale handed in (a
+    // figure fitted against ground truth) gives: learning costs the first minutes, which weigh
+    // most on the shorter Plaza 2 (409 s). Measured 3 % and 13 % (docs/range-calibration.md);
+    // the bound was 10 % with the earlier noise settings, under which the scale handed in did
+    // worse (in `run`, 0.405 m on Plaza 2 then, 0.365 m now) and the learnt run hardly
+    // differently (0.430 m then).
     TofDecoderConfig given = decoding;
     given.range_scale = 1.069;
-    const ReplayRun handed_in = replay(path, given, options,
-                                       {"init_window_s=20", "max_odometry_gap_s=0.5", "init_max_position_sigma_m=2",
-                                        "init_max_yaw_sigma_rad=0.5"});
+    const ReplayRun handed_in = replay(path, given, options, {});
     std::printf("%s with --range-scale 1.069: position RMS %.3f m\n", name, handed_in.metrics.position_rms_m);
-    EXPECT_LT(r.metrics.position_rms_m, 1.1 * handed_in.metrics.position_rms_m) << name;
+    EXPECT_LT(r.metrics.position_rms_m, 1.15 * handed_in.metrics.position_rms_m) << name;
   }
   if (replayed == 0) GTEST_SKIP() << "no CMU Plaza recording beside the repository";
 }

@@ -103,7 +103,7 @@ TEST_F(Run, EvalReproducesTheMetricsOfARun) {
 TEST_F(Run, ReplaysTheTucFixture) {
   const auto [code, out] =
       beaconloc({"run", "--replay", kSource + "/tests/data/tuc_labyrinth_30s", "--max-range-m", "10",
-                 "--range-sigma-m", "0.15", "--param", "init_window_s=5", "--out", dir_});
+                 "--range-sigma-m", "0.1", "--out", dir_});
   ASSERT_EQ(code, 0) << out;
   const std::string metrics = read(dir_ + "/metrics.json");
   EXPECT_GT(json_number(metrics, "samples"), 150);
@@ -119,7 +119,7 @@ TEST_F(Run, AReplayWithoutGroundTruthIsLocalizedAndNotScored) {
   std::filesystem::copy(kSource + "/tests/data/tuc_labyrinth_30s", replay);
   std::filesystem::remove(replay + "/gt.csv");
   const auto [code, out] = beaconloc({"run", "--replay", replay, "--max-range-m", "10", "--range-sigma-m",
-                                      "0.15", "--param", "init_window_s=5", "--out", dir_ + "/out"});
+                                      "0.1", "--out", dir_ + "/out"});
   ASSERT_EQ(code, 0) << out;
   EXPECT_NE(out.find("no ground truth: not scored"), std::string::npos) << out;
   const std::string metrics = read(dir_ + "/out/metrics.json");
@@ -251,13 +251,12 @@ struct Recording {
 TEST_F(Run, ReplaysTheSharedRecordings) {
   const std::vector<Recording> recordings = {
       {"tuc_labyrinth_uwb/replay/full_933s",
-       {"--max-range-m", "10", "--range-sigma-m", "0.15", "--param", "init_window_s=5", "--param",
+       {"--max-range-m", "10", "--range-sigma-m", "0.1", "--replay-odometry-k-v", "0.0001", "--param",
         "range_calibration=1"},
        0.5},
       {"cmu_plaza_gpslam/replay/plaza1",
-       {"--max-range-m", "150", "--range-sigma-m", "1.0", "--replay-odometry-k-v", "0.001", "--replay-heading-arw",
-        "0.014", "--param", "init_window_s=20", "--param", "max_odometry_gap_s=0.5", "--param", "init_max_position_sigma_m=2", "--param",
-        "init_max_yaw_sigma_rad=0.5", "--param", "range_calibration=1"},
+       {"--max-range-m", "150", "--range-sigma-m", "0.55", "--replay-odometry-k-v", "0.003", "--replay-heading-arw",
+        "0.014", "--param", "range_calibration=1"},
        2.0}};
   int replayed = 0;
   for (const auto& r : recordings) {

@@ -63,7 +63,7 @@ TEST(StartupWait, RangeEkfNamesWhatItWaitsFor) {
   EXPECT_EQ(few.condition(), StartupCondition::kTooFewRanges);
   EXPECT_EQ(few.describe(), "9 of 20 ranges");
 
-  Standing uncertain("range_ekf", {{"init_max_position_sigma_m", 1e-4}});
+  Standing uncertain("range_ekf", {{"init_max_position_sigma_m", 1e-4}, {"init_max_position_sigma_ranges", 0.0}});
   uncertain.e_->set_beacon_map(kMap);
   uncertain.slots(3, {1, 2, 3});
   EXPECT_EQ(uncertain.condition(), StartupCondition::kPositionTooUncertain) << uncertain.describe();

@@ -102,11 +102,17 @@ void ReplaySource::load_beacons(const std::string& path) {
   }
 }
 
-Eigen::Matrix2d ReplaySource::odometry_covariance(bool own_wheels, double v_mps, double right_mps, double left_mps,
-                                                  double dt_s, double half_track_m) const {
+namespace {
+// (v, omega) as the speeds [right, left] of wheels half_track_m from the middle: v +- omega b.
+Eigen::Vector2d wheel_speeds_mps(double v_mps, double omega_radps, double half_track_m) {
+  return {v_mps + omega_radps * half_track_m, v_mps - omega_radps * half_track_m};
+}
+}  // namespace
+
+Eigen::Matrix2d ReplaySource::odometry_covariance(bool own_wheels, double v_mps, double omega_radps, double dt_s,
+                                                  double half_track_m) const {
   if (own_wheels) {
-    return Eigen::Vector2d(options_.odometry_k_v_m * std::abs(right_mps) / dt_s,
-                           options_.odometry_k_v_m * std::abs(left_mps) / dt_s)
+    return (options_.odometry_k_v_m * wheel_speeds_mps(v_mps, omega_radps, half_track_m).cwiseAbs() / dt_s)
         .asDiagonal();
   }
   // Noise on (v, omega), independent, carried exactly by the wheel speeds [v_R, v_L] = A [v, omega]
@@ -151,7 +157,8 @@ void ReplaySource::load_odometry(const std::string& path) {
       continue;
     }
     // (v, omega) become wheel speeds v +- omega * B/2: each within the physical limit.
-    const double right = v + w * half_track, left = v - w * half_track;
+    const Eigen::Vector2d wheels_mps = wheel_speeds_mps(v, w, half_track);
+    const double right = wheels_mps(0), left = wheels_mps(1);
     if (!(std::abs(right) <= kMaxWheelSpeedMps && std::abs(left) <= kMaxWheelSpeedMps)) {
       std::ostringstream why;
       why << "omega_radps " << csv.cell("omega_radps") << " turns the wheels at " << right << " and " << left
@@ -186,7 +193,7 @@ void ReplaySource::load_odometry(const std::string& path) {
     e.odometry.wheel_base_m = 2.0 * half_track;
     e.odometry.wheel_velocity_right_mps = right;
     e.odometry.wheel_velocity_left_mps = left;
-    e.odometry.wheel_velocity_covariance = odometry_covariance(has_half_track, v, right, left, dt, half_track);
+    e.odometry.wheel_velocity_covariance = odometry_covariance(has_half_track, v, w, dt, half_track);
     events_.push_back(e);
   }
 }

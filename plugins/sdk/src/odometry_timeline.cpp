@@ -1,5 +1,6 @@
 #include "beaconloc/core/odometry_timeline.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "beaconloc/core/limits.hpp"
@@ -48,7 +49,10 @@ OdometryTimeline::Step OdometryTimeline::advance(const OdometrySample& o) {
   } else {
     step.dt_s = ns_to_s(o.stamp_ns - *last_stamp_ns_);
     last_stamp_ns_ = o.stamp_ns;
-    if (step.dt_s > max_gap_s_) {
+    const double limit_s = gap_limit_s();  // the period as it stood before this interval
+    intervals_s_[interval_count_ % kPeriodSamples] = step.dt_s;
+    ++interval_count_;
+    if (step.dt_s > limit_s) {
       // Integrating the velocities over the whole gap would invent motion: the sample
       // re-anchors the time line and the gap is reported.
       step.result = InputResult::rejected(Rejection::kOdometryGap);
@@ -57,6 +61,15 @@ OdometryTimeline::Step OdometryTimeline::advance(const OdometrySample& o) {
     }
   }
   return step;
+}
+
+double OdometryTimeline::gap_limit_s() const {
+  if (interval_count_ < kMinPeriodSamples) return max_gap_s_;
+  std::array<double, kPeriodSamples> sorted = intervals_s_;
+  const std::size_t n = std::min(interval_count_, kPeriodSamples);
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.begin() + n);
+  const double period_s = sorted[n / 2];
+  return std::max(max_gap_s_, std::min(kGapPeriods * period_s, kMaxLearntGapS));
 }
 
 }  // namespace beaconloc

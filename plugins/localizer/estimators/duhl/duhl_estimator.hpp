@@ -28,7 +28,7 @@ struct DuhlParameters {
   // `beaconloc accuracy` on trajectory 4, seeds 1-20: without it seed 19 stayed lost (E_p RMS
   // 0.191 m); with it that seed ends at 0.094 m, the other 19 unchanged.
   int reinitialize_after_gated = 10;
-  double max_odometry_gap_s = 0.2;
+  double max_odometry_gap_s = kDefaultMaxOdometryGapS;
   double wheel_velocity_variance_floor_m2ps2 = 1e-6;
   // Before the first pose, a new Tx's unmeasured receivers start from the measured one with
   // this standard deviation (the receivers are 0.33 m apart).

@@ -32,7 +32,8 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
   ParameterReader in(c, "range_ekf");
   RangeEkfParameters p;
   p.nis_gate = in.real("nis_gate", p.nis_gate, ranges::kChiSquareGate);
-  p.init_window_s = in.real("init_window_s", p.init_window_s, ParameterRange::above(0.0, 60.0));
+  p.init_window_s =
+      in.real("init_window_s", p.init_window_s, ParameterRange::above(0.0, RangeEkfParameters::kMaxInitWindowS));
   p.init_min_beacons = in.count("init_min_beacons", p.init_min_beacons, 1, 100);
   p.init_min_ranges =
       in.count("init_min_ranges", p.init_min_ranges, static_cast<int>(kRangePoseMinObservations), 1000);
@@ -41,6 +42,8 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
   p.max_range_age_s = in.real("max_range_age_s", p.max_range_age_s, ranges::kDataDurationS);
   p.init_max_position_sigma_m =
       in.real("init_max_position_sigma_m", p.init_max_position_sigma_m, ranges::kPositionSigmaM);
+  p.init_max_position_sigma_ranges = in.real("init_max_position_sigma_ranges", p.init_max_position_sigma_ranges,
+                                             ParameterRange::closed(0.0, 100.0));
   p.init_max_yaw_sigma_rad =
       in.real("init_max_yaw_sigma_rad", p.init_max_yaw_sigma_rad, ranges::kHeadingSigmaRad);
   p.init_retry_interval_s = in.real("init_retry_interval_s", p.init_retry_interval_s,
@@ -102,8 +105,11 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
   // Every good range joins the window a global fix is computed from.
   const Pose2 odom_pose_at_range = odom_pose_at(r.stamp_ns);
   window_.push_back({r, odom_pose_at_range});
-  while (!window_.empty() && (window_.front().range.stamp_ns < r.stamp_ns - s_to_ns(params_.init_window_s) ||
-                              window_.size() > kMaxWindowRanges)) {
+  const auto older_than = [&](double age_s) { return window_.front().range.stamp_ns < r.stamp_ns - s_to_ns(age_s); };
+  while (!window_.empty() &&
+         (window_.size() > RangeEkfParameters::kMaxWindowRanges || older_than(RangeEkfParameters::kMaxInitWindowS) ||
+          (older_than(params_.init_window_s) &&
+           window_.size() > static_cast<std::size_t>(params_.init_min_ranges)))) {
     window_.pop_front();
   }
   if (!has_pose()) {
@@ -116,7 +122,7 @@ InputResult RangeEkf::update(const RangeMeasurement& r) {
 Pose2 RangeEkf::odom_pose_at(StampNs stamp_ns) const {
   if (!last_odometry_ || !now_ns()) return odom_pose_;
   const double lag_s = ns_to_s(stamp_ns - *now_ns());
-  if (std::abs(lag_s) > params_.max_odometry_gap_s) return odom_pose_;
+  if (std::abs(lag_s) > odometry_gap_limit_s()) return odom_pose_;
   const OdometrySample& o = *last_odometry_;
   return predict_diff_drive(odom_pose_, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps, o.wheel_base_m, lag_s)
       .pose;
@@ -317,6 +323,7 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
 
   std::vector<RangeObservation> observations;
   std::vector<std::uint32_t> observed_beacons;  // beside observations
+  std::vector<double> range_variances_m2;       // as the calibration reads them, without the drift's share
   for (std::size_t k = 0; k < window_.size(); ++k) {
     const BufferedRange& b = window_[k];
     const Beacon* beacon = map().find(b.range.beacon_id);
@@ -334,6 +341,7 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
     o.range_m = range.range_m;
     // Odometry drift over the window adds to the range noise: 2 % of the distance travelled.
     o.variance_m2 = range.variance_m2 + std::pow(0.02 * travelled_m, 2);
+    range_variances_m2.push_back(range.variance_m2);
     observations.push_back(o);
     observed_beacons.push_back(b.range.beacon_id);
   }
@@ -346,6 +354,9 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
                    {}};
     return out;
   }
+  std::nth_element(range_variances_m2.begin(), range_variances_m2.begin() + range_variances_m2.size() / 2,
+                   range_variances_m2.end());
+  const double median_range_sigma_m = std::sqrt(range_variances_m2[range_variances_m2.size() / 2]);
   // Echoes (a reflection's longer path) in the window would pull the fix off the pose: drop the
   // ranges the fix cannot explain (core/solvers/range_pose_solver.hpp).
   RangePoseSolverOptions solver;
@@ -370,9 +381,12 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
     return out;
   }
   const double position_sigma_m = std::sqrt(fix.covariance(0, 0) + fix.covariance(1, 1));
-  if (position_sigma_m > params_.init_max_position_sigma_m) {  // geometry too weak yet
-    out.why_not = {
-        StartupCondition::kPositionTooUncertain, position_sigma_m, params_.init_max_position_sigma_m, {}};
+  const double max_position_sigma_m =
+      std::max(params_.init_max_position_sigma_m,
+               std::min(params_.init_max_position_sigma_ranges * median_range_sigma_m,
+                        parameter_ranges::kPositionSigmaM.max));
+  if (position_sigma_m > max_position_sigma_m) {  // geometry too weak yet
+    out.why_not = {StartupCondition::kPositionTooUncertain, position_sigma_m, max_position_sigma_m, {}};
     return out;
   }
   const double yaw_sigma_rad = std::sqrt(fix.covariance(2, 2));
@@ -436,7 +450,8 @@ std::vector<Estimator::StateValue> RangeEkf::state_values() const {
     out.push_back({"range_innovation_nll_nats", innovation_nll_sum_ / static_cast<double>(innovations_), 0.0});
   }
   if (!calibration_.enabled()) return out;
-  for (const StateValue& v : calibration_.values(calibrating_.state(), calibrating_.covariance())) out.push_back(v);
+  const std::vector<StateValue> calibration = calibration_.values(calibrating_.state(), calibrating_.covariance());
+  out.insert(out.end(), calibration.begin(), calibration.end());
   out.push_back({"range_calibration_resets", static_cast<double>(calibration_resets_), 0.0});
   out.push_back({"range_calibration_uncalibrated_beacons", static_cast<double>(calibration_.uncalibrated_beacons()), 0.0});
   return out;

@@ -21,12 +21,31 @@ namespace beaconloc {
 
 struct RangeEkfParameters {
   double nis_gate = kChiSquare999OneDof;
-  double init_window_s = 3.0;  // ranges kept for a global fix
+  // The ranges a global fix is computed from: those of the last init_window_s, or the newest
+  // init_min_ranges when that holds fewer (with the defaults, a single receiver ranging under 2.7
+  // times a second: the CMU radios range 2-4 times a second), never older than kMaxInitWindowS.
+  // Ranges the echo screen then drops leave the fix waiting for more. (Not more: a longer window's
+  // dead-reckoned path, its drift not in the fix's noise, tells a mirror image from the pose by
+  // chance; unit.RangeEkf.StaysInitializingUnderARowOfBeaconsWithOneReceiverAndSaysWhy.)
+  static constexpr double kMaxInitWindowS = 60.0;
+  // And at most this many: 5 slots a second, up to 8 receivers, the longest window is 2400; a bus
+  // flooding ranges (any number within the window's span) must not make each range's work grow
+  // without bound.
+  static constexpr std::size_t kMaxWindowRanges = 2400;
+  double init_window_s = 3.0;
   int init_min_beacons = 3;
   int init_min_ranges = 8;  // ranges (after the echo screen) a global fix needs: 3 unknowns + 5
+  // A fix starts the filter when its position sigma is below the larger of
+  // init_max_position_sigma_m and init_max_position_sigma_ranges times the window's typical range
+  // sigma (its median): ranges with 0.5 m noise (the CMU radios) cannot give a 0.3 m fix. That
+  // product stops at the largest init_max_position_sigma_m there is, whatever sigma a source
+  // declares.
   double init_max_position_sigma_m = 0.3;
+  double init_max_position_sigma_ranges = 2.0;
   double init_max_yaw_sigma_rad = 0.35;
-  double max_odometry_gap_s = 0.2;  // a longer gap is not integrated (reason odometry_gap)
+  // A longer gap is not integrated (reason odometry_gap), unless a slower sensor's own period
+  // allows it (OdometryTimeline).
+  double max_odometry_gap_s = kDefaultMaxOdometryGapS;
   double wheel_velocity_variance_floor_m2ps2 = 1e-6;
   int reinitialize_after_gated = 15;   // 5 slots x 3 receivers refused in a row: lost
   // Ranges older than the newest odometry by more are stale.
@@ -139,12 +158,9 @@ class RangeEkf final : public EstimatorBase {
   // The newest sample the time line stands at (integrated, its anchor, or re-anchored after a gap).
   std::optional<OdometrySample> last_odometry_;
   // The dead-reckoned pose at stamp_ns: odom_pose_ moved along the newest wheel speeds over
-  // stamp_ns - now_ns() (either sign, at most max_odometry_gap_s; odom_pose_ beyond that).
+  // stamp_ns - now_ns() (either sign, at most odometry_gap_limit_s(); odom_pose_ beyond that).
   Pose2 odom_pose_at(StampNs stamp_ns) const;
-  // The newest ranges, in stamp order, within init_window_s and at most kMaxWindowRanges: 5 slots
-  // a second, up to 8 receivers, the longest window (60 s) is 2400; a bus flooding ranges (any
-  // number within the window's span) must not make each range's work grow without bound.
-  static constexpr std::size_t kMaxWindowRanges = 2400;
+  // The newest ranges, in stamp order (RangeEkfParameters: the window's span and size).
   std::deque<BufferedRange> window_;
   int consecutive_gated_ = 0;
   std::optional<StampNs> last_init_attempt_ns_;

@@ -62,7 +62,7 @@ struct ScanParameters {
   // in seed003_scan.yaml; at once in the paper).
   double epoch_window_s = 0.1;
   double overlap_end_s = 2.0;       // see the header: > 2 of a group's cycles (0.76 s)
-  double max_odometry_gap_s = 0.2;
+  double max_odometry_gap_s = kDefaultMaxOdometryGapS;
   double wheel_velocity_variance_floor_m2ps2 = 1e-6;
   bool inverse_trajectory = true;  // Sec. 3.6
   // In a GRULPS's coverage this long before the backwards drive starts from there: the drive

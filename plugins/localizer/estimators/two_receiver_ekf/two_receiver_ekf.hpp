@@ -35,7 +35,7 @@ struct TwoReceiverEkfParameters {
   // The two receivers' estimates are suspect (the pose degraded) while their distance differs
   // from the mounting's separation by more than this many sigma.
   double separation_gate_sigma = 4.0;
-  double max_odometry_gap_s = 0.2;
+  double max_odometry_gap_s = kDefaultMaxOdometryGapS;
   double wheel_velocity_variance_floor_m2ps2 = 1e-6;
 
   static TwoReceiverEkfParameters from(const EstimatorConfig& config);

@@ -33,7 +33,7 @@ struct UkfLrfParameters {
   double initial_sigma_xy_m = 0.05;
   double initial_sigma_yaw_rad = 0.05;
   Pose2 laser_mount_base = Pose2::Zero();
-  double max_odometry_gap_s = 0.2;
+  double max_odometry_gap_s = kDefaultMaxOdometryGapS;
   int max_beams = 19;                  // N_W of Sec. 3.4: longer scans are thinned evenly
   double max_measurement_age_s = 0.1;  // a range or scan older than this behind the filter is stale
 

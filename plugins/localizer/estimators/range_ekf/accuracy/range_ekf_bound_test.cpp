@@ -62,9 +62,9 @@ TEST(RangeEkfAgainstTheBound, Seed000TrajectoriesWithinAQuarterOfIt) {
 }
 
 // The classroom's one receiver hears one beacon every 156 ms at sigma 0.4 m: range_ekf finds
-// itself from the beacons (it is not told the start, the bound is) and has no heading until the
+// itself from the beacons (neither it nor its bound is told the start) and has no heading until the
 // robot has moved, so the first 15 s (the first leg, 3.7 m, and its turn) are its start, not its
-// tracking. Over those too it is 1.5x (position) and 3x (heading) the bound (docs/bound.md).
+// tracking. Over those too it is 1.28x (position) and 2.11x (heading) the bound (docs/bound.md).
 // Thirty seeds: the heading error wanders slowly, so a run is few independent samples of it.
 TEST(RangeEkfAgainstTheBound, Seed001ClassroomWithinAQuarterOfItOnceStarted) {
   sim::Scenario classroom = example("seed001_classroom");

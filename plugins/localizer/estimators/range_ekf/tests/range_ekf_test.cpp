@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <optional>
 
 #include "beaconloc/core/estimator_registry.hpp"
 #include "offline_pipeline.hpp"
@@ -115,7 +117,6 @@ TEST(RangeEkf, ARangeBetweenTwoOdometrySamplesIsFusedWhereTheRobotWasAtItsStamp)
                        {4, {2.0, -3.0, 2.5}, 0}});
   EstimatorConfig config;
   config.receivers = receivers;
-  config.parameters = {{"max_odometry_gap_s", 0.5}};
   RangeEkf ekf(config);
   ekf.set_beacon_map(map);
   constexpr double kSpeedMps = 1.0;
@@ -141,6 +142,65 @@ TEST(RangeEkf, ARangeBetweenTwoOdometrySamplesIsFusedWhereTheRobotWasAtItsStamp)
     worst_error_m = std::max(worst_error_m, (estimate.head<2>() - truth_at(o.stamp_ns).head<2>()).norm());
   }
   EXPECT_LT(worst_error_m, 2e-3);
+}
+
+// A radio ranging sensor as the CMU mower's: one receiver, a range every 0.5 s (2 Hz, round
+// robin over four beacons 20-30 m apart) with 0.6 m noise, odometry at 10 Hz, the robot driving
+// straight at 2 m/s. With the defaults it starts: the window holds the init_min_ranges (8) a
+// fix needs, not the 6 of init_window_s (with those alone it waited for ever: too few ranges),
+// and a fix whose sigma is within twice the ranges' is certain enough (with the absolute limit
+// alone it waits, saying why). (Exact ranges: the fix is exact.)
+struct SlowRadioRun {
+  std::optional<double> first_pose_s;
+  double worst_error_m = 0.0;  // from the first pose
+  std::optional<StartupWait> wait;
+};
+
+SlowRadioRun slow_radio(const std::map<std::string, double>& parameters) {
+  const BeaconMap map({{1, {0.0, 0.0, 0.0}, 0}, {2, {20.0, 0.0, 0.0}, 0}, {3, {10.0, 15.0, 0.0}, 0},
+                       {4, {10.0, -15.0, 0.0}, 0}});
+  EstimatorConfig config;
+  config.receivers = ReceiverArray::on_circle(0.0, 1);
+  config.parameters = parameters;
+  RangeEkf ekf(config);
+  ekf.set_beacon_map(map);
+  constexpr double kSpeedMps = 2.0;
+  const auto truth_at = [](StampNs stamp_ns) { return Pose2(-15.0 + kSpeedMps * ns_to_s(stamp_ns), 4.0, 0.0); };
+  SlowRadioRun out;
+  OdometrySample o;
+  o.wheel_base_m = 0.5;
+  o.wheel_velocity_right_mps = o.wheel_velocity_left_mps = kSpeedMps;
+  for (int k = 0; k <= 400; ++k) {  // 40 s
+    o.stamp_ns = k * 100'000'000LL;
+    EXPECT_TRUE(ekf.predict(o).accepted);
+    if (k % 5 == 0) {
+      const Beacon& beacon = *map.find(1 + static_cast<std::uint32_t>((k / 5) % 4));
+      for (const RangeMeasurement& r : test_support::exact_ranges(truth_at(o.stamp_ns), config.receivers, beacon,
+                                                                  o.stamp_ns, 0.36)) {
+        EXPECT_TRUE(ekf.update(r).accepted);
+      }
+    }
+    if (const auto estimate = ekf.estimate()) {
+      if (!out.first_pose_s) out.first_pose_s = ns_to_s(o.stamp_ns);
+      out.worst_error_m = std::max(
+          out.worst_error_m, (estimate->pose_map_base.head<2>() - truth_at(o.stamp_ns).head<2>()).norm());
+    }
+  }
+  out.wait = ekf.startup_wait();
+  return out;
+}
+
+TEST(RangeEkf, ASlowNoisyRangingSensorStartsWithTheDefaults) {
+  const SlowRadioRun defaults = slow_radio({});
+  ASSERT_TRUE(defaults.first_pose_s) << (defaults.wait ? defaults.wait->describe() : "");
+  EXPECT_LT(*defaults.first_pose_s, 25.0);
+  EXPECT_LT(defaults.worst_error_m, 0.5);
+  std::printf("first pose at %.1f s, worst error since %.3f m\n", *defaults.first_pose_s, defaults.worst_error_m);
+
+  const SlowRadioRun absolute_limit_only = slow_radio({{"init_max_position_sigma_ranges", 0.0}});
+  EXPECT_FALSE(absolute_limit_only.first_pose_s);
+  ASSERT_TRUE(absolute_limit_only.wait);
+  EXPECT_EQ(absolute_limit_only.wait->condition, StartupCondition::kPositionTooUncertain);
 }
 
 TEST(RangeEkf, DegradesWithoutRangesAndRecoversWhenTheyReturn) {

@@ -55,6 +55,8 @@ class EstimatorBase : public Estimator {
   // The estimator's time: its newest odometry stamp.
   std::optional<StampNs> now_ns() const { return timeline_.last_stamp_ns(); }
   OdometryTimeline::Step advance(const OdometrySample& o) { return timeline_.advance(o); }
+  // The longest odometry interval integrated now (OdometryTimeline::gap_limit_s).
+  double odometry_gap_limit_s() const { return timeline_.gap_limit_s(); }
   const BeaconMap& map() const { return map_; }
 
  private:
