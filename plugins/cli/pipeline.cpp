@@ -52,6 +52,8 @@ constexpr std::uint64_t kMaxOdometryLead = 25;
 constexpr std::uint64_t kMaxTofLead = 8;
 // A consumer that takes nothing for this long while it lacks samples lost them on the way.
 constexpr auto kLostAfter = 2s;
+// How long the gateway's first sample waits for its beacon map to reach the consumers.
+constexpr auto kMapDeliveryTimeout = 5s;
 
 class ChildProcess {
  public:
@@ -330,7 +332,20 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
     for (const auto& s : now) n += s.processed;
     return n;
   };
+  bool map_delivered = false;
   auto throttle = [&] {
+    // Before the first sample: hold the gateway until its beacon map (written first, on a topic of
+    // its own) has reached the localizer and the decoder, else their first ranges and TOFs would
+    // be refused as no_beacon_map for overtaking it (a reliable resend of a lost map sample waits
+    // for the writer's heartbeat). Not beyond kMapDeliveryTimeout: then the refusals are counted.
+    if (!map_delivered) {
+      const auto give_up = std::chrono::steady_clock::now() + kMapDeliveryTimeout;
+      while (!(localizer.has_beacon_map() && (pulses || decoder.has_beacon_map())) &&
+             std::chrono::steady_clock::now() < give_up) {
+        std::this_thread::sleep_for(1ms);
+      }
+      map_delivered = true;
+    }
     // Hold the gateway back while the decoder or the localizer lags (speed 0: as fast as they go),
     // as long as they take samples: what they lack when they took none for kLostAfter was lost.
     auto now = streams();

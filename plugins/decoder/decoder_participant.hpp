@@ -23,6 +23,11 @@ class DecoderParticipant {
   // TOFs taken from the bus and ranges written, for a throttle in the same process.
   std::uint64_t tofs_processed() const { return tofs_processed_.load(); }
   std::uint64_t ranges_written() const { return ranges_written_.load(); }
+  // Whether a beacon map has reached it (see LocalizerParticipant::has_beacon_map).
+  bool has_beacon_map() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return decoder_.has_beacon_map();
+  }
 
  private:
   msg::Diagnostics diagnostics_snapshot();

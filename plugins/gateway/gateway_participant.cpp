@@ -255,6 +255,7 @@ void GatewayParticipant::run() {
       source_->relative_stamps() && options_.wall_clock_stamps ? dds::wall_clock_ns() : 0;
   auto beacon_map = dds::to_msg(source_->beacon_map(), options_.frame_id);
   count(map_writer_->write(&beacon_map));
+  if (throttle_) throttle_();  // before the first sample: the map may be waited for
 
   std::vector<SourceEvent> events;
   const StampNs step_ns = 10 * kNsPerMillisecond;

@@ -59,7 +59,8 @@ class GatewayParticipant {
  public:
   // Truth of the source at a stamp (the stamp the published samples carry).
   using TruthCallback = std::function<void(StampNs stamp_ns, const Pose2& truth_map_base, bool has_yaw)>;
-  // Called after each step's samples are written; may block to hold the gateway back.
+  // Called once the beacon map is written, before the first sample, and after each step's
+  // samples are written; may block to hold the gateway back.
   using Throttle = std::function<void()>;
 
   GatewayParticipant(const dds::DdsOptions& dds, GatewayOptions options, std::unique_ptr<Source> source,

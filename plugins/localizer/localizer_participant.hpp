@@ -52,6 +52,12 @@ class LocalizerParticipant {
   // Poses written (one per odometry sample once localized, plus corrections), and the stamp of
   // the newest odometry sample taken: for benchmarks in the same process.
   std::uint64_t poses_written() const { return poses_written_.load(); }
+  // Whether a beacon map has reached it: a throttle in the same process holds the data back
+  // until then, so that no good range is refused as no_beacon_map for arriving first.
+  bool has_beacon_map() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return core_.has_beacon_map();
+  }
   StampNs newest_odometry_stamp_ns() const { return newest_odometry_stamp_ns_.load(); }
   std::uint64_t lost_increments() {
     std::lock_guard<std::mutex> lock(mutex_);
