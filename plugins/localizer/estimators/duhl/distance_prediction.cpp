@@ -119,4 +119,28 @@ DistanceInit initial_distances(const Pose2& pose, const Cov3& pose_covariance,
   return out;
 }
 
+bool possible_distances(const Distances& d, double variance_m2, const ReceiverRing& ring) {
+  const double slack_m = kDefaultResidualGateSigma * std::sqrt(2.0 * variance_m2);
+  for (int a = 0; a < 3; ++a) {
+    for (int b = a + 1; b < 3; ++b) {
+      const double separation_m = (ring.receiver(a) - ring.receiver(b)).norm();
+      if (!(std::abs(d(a) - d(b)) <= separation_m + slack_m)) return false;
+    }
+  }
+  return true;
+}
+
+bool explains_distances(const std::vector<TxBelief>& txs, const Pose2& pose, const Cov3& pose_covariance,
+                        const ReceiverRing& ring, double gate_sigma) {
+  for (const TxBelief& tx : txs) {
+    const DistanceInit expected = initial_distances(pose, pose_covariance, tx.tx_map_m, ring);
+    for (int l = 0; l < 3; ++l) {
+      const double sigmas =
+          std::abs(tx.q(l) - expected.q(l)) / std::sqrt(tx.covariance(l, l) + expected.covariance(l, l));
+      if (!(sigmas <= gate_sigma)) return false;  // a non-finite residual does not explain
+    }
+  }
+  return true;
+}
+
 }  // namespace beaconloc::duhl
