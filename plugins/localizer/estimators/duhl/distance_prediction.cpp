@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "beaconloc/core/models/range_model.hpp"
+#include "beaconloc/core/receiver_array.hpp"
 
 namespace beaconloc::duhl {
 
@@ -120,11 +121,10 @@ DistanceInit initial_distances(const Pose2& pose, const Cov3& pose_covariance,
 }
 
 bool possible_distances(const Distances& d, double variance_m2, const ReceiverRing& ring) {
-  const double slack_m = kDefaultResidualGateSigma * std::sqrt(2.0 * variance_m2);
   for (int a = 0; a < 3; ++a) {
     for (int b = a + 1; b < 3; ++b) {
       const double separation_m = (ring.receiver(a) - ring.receiver(b)).norm();
-      if (!(std::abs(d(a) - d(b)) <= separation_m + slack_m)) return false;
+      if (!ranges_of_one_firing_agree(d(a), d(b), separation_m, 2.0 * variance_m2)) return false;
     }
   }
   return true;

@@ -64,9 +64,8 @@ struct TxBelief {
 bool explains_distances(const std::vector<TxBelief>& txs, const Pose2& pose, const Cov3& pose_covariance,
                         const ReceiverRing& ring, double gate_sigma);
 
-// The triangle inequality between two receivers and a Tx: two distances of one firing differ by
-// at most the receivers' separation, within kDefaultResidualGateSigma of the difference's
-// sigma. False when an echo made one distance too long (or a distance is not finite).
+// The triangle inequality between each two receivers and a Tx (ranges_of_one_firing_agree):
+// false when an echo made one distance too long (or a distance is not finite).
 bool possible_distances(const Distances& d, double variance_m2, const ReceiverRing& ring);
 
 }  // namespace beaconloc::duhl

@@ -16,9 +16,6 @@
 namespace beaconloc {
 
 namespace {
-// Arrivals of one firing at the receivers of one robot: within the time sound takes to cross the
-// robot (0.4 m / 343 m/s = 1.2 ms), far less than the 200 ms between two firings.
-constexpr StampNs kSameFiringNs = 20 * kNsPerMillisecond;
 // One pose is preferred to another (a global fix to its mirror image, a fix to a suspect
 // filter pose) when it fits the same ranges better by this much weighted squared residual.
 // Whichever of two poses is the robot's, noise makes the other fit better by T with probability
@@ -299,9 +296,7 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
                    {}};
     return out;
   }
-  // Echoes, screened by geometry alone: two receivers d apart hearing one firing measure ranges
-  // that differ by at most d (triangle inequality); an echo's path is longer, so of a pair that
-  // differs by more, the longer range is the echo. O(n^2) over a window of at most
+  // Echoes, screened by geometry alone (ranges_of_one_firing_agree). O(n^2) over a window of at most
   // kMaxWindowRanges (not in strict stamp order: ranges a little ahead of the odometry are
   // taken as they arrive).
   std::vector<bool> echo(window_.size(), false);
@@ -315,7 +310,7 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
       }
       const double baseline_m =
           (receivers_.receivers_base_m[a.receiver_id] - receivers_.receivers_base_m[b.receiver_id]).norm();
-      if (std::abs(a.range_m - b.range_m) > baseline_m + 3.0 * std::sqrt(a.variance_m2 + b.variance_m2)) {
+      if (!ranges_of_one_firing_agree(a.range_m, b.range_m, baseline_m, a.variance_m2 + b.variance_m2)) {
         echo[a.range_m > b.range_m ? i : j] = true;
       }
     }

@@ -107,6 +107,16 @@ InputResult TwoReceiverEkf::predict(const OdometrySample& o) {
 InputResult TwoReceiverEkf::update(const RangeMeasurement& r) {
   if (const InputResult checked = check_range(r, map(), 2); !checked.accepted) return checked;
   if (!has_pose()) return InputResult::rejected(Rejection::kNoInitialPose);
+  // The other receiver heard the same firing first when its path is shorter: an echo here is
+  // the longer one of the pair. (Heard first, an echo cannot be told: the direct range after it
+  // is shorter.)
+  const std::optional<RangeMeasurement>& other = last_heard_[1 - r.receiver_id];
+  last_heard_[r.receiver_id] = r;
+  if (other && other->beacon_id == r.beacon_id && std::abs(r.stamp_ns - other->stamp_ns) <= kSameFiringNs &&
+      r.range_m > other->range_m &&
+      !ranges_of_one_firing_agree(r.range_m, other->range_m, pair_.separation_m(), r.variance_m2 + other->variance_m2)) {
+    return InputResult::rejected(Rejection::kEchoOfFiring);
+  }
   Ekf<2>& filter = receivers_[r.receiver_id];
   GateState& gate = gates_[r.receiver_id];
   const PointRangeModel model(receiver_z_m_, map().find(r.beacon_id)->position_map_m, r.variance_m2);

@@ -4,8 +4,11 @@
 // eq. 4-1: updated by each range to a ceiling generator at a known position, eq. 5-10), and the
 // robot's pose is taken from the pair (eq. 11) with the covariance eq. 12 gives
 // (receiver_pair.hpp). Placed by hand, as in the paper's experiment (Sec. 4: "the initial value
-// of the posture estimation are set arbitrary").
+// of the posture estimation are set arbitrary"). Not in the paper: of the two receivers' ranges
+// to one firing, one longer than the receivers' separation allows is refused as an echo
+// (ranges_of_one_firing_agree): until a receiver's gate closes, nothing else keeps an echo out.
 #include <array>
+#include <optional>
 
 #include "beaconloc/core/chi_square.hpp"
 #include "beaconloc/core/estimator_base.hpp"
@@ -71,6 +74,9 @@ class TwoReceiverEkf final : public EstimatorBase {
     bool closed = false;
   };
   std::array<GateState, 2> gates_{};
+  // Each receiver's last range, to tell an echo by the other receiver's range of the same firing
+  // (not in the paper: its ranges are all direct).
+  std::array<std::optional<RangeMeasurement>, 2> last_heard_{};
 };
 
 }  // namespace beaconloc
