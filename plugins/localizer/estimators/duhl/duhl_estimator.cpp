@@ -73,6 +73,7 @@ DuhlParameters DuhlParameters::from(const EstimatorConfig& c) {
   p.distance_innovation_gate =
       in.real("distance_innovation_gate", p.distance_innovation_gate, ranges::kChiSquareGateOrOff);
   p.range_pose_gate = in.real("range_pose_gate", p.range_pose_gate, ranges::kChiSquareGateOrOff);
+  p.suspect_after_gated_ranges = in.count("suspect_after_gated_ranges", p.suspect_after_gated_ranges, 1, 1000);
   p.lost_after_gated_ranges = in.count("lost_after_gated_ranges", p.lost_after_gated_ranges, 1, 1000);
   p.start_residual_gate_sigma =
       in.real("start_residual_gate_sigma", p.start_residual_gate_sigma, ParameterRange::above(0.0, 100.0));
@@ -210,7 +211,8 @@ Duhl::UhlFix Duhl::solve(std::optional<std::uint32_t> left_out) const {
   std::vector<TxDistances> txs;
   std::vector<DistanceCov> covariances;
   std::vector<TxBelief> beliefs;
-  const double reuse = static_cast<double>(available_.size());
+  // |T_A| of the Txs this solve takes (see observation R above).
+  const double reuse = static_cast<double>(available_.size() - (left_out && available_.count(*left_out) ? 1 : 0));
   for (const auto& [id, e] : available_) {
     if (id == left_out) continue;
     const Eigen::Vector3d& tx_map_m = map().find(id)->position_map_m;
@@ -241,49 +243,57 @@ std::optional<Duhl::UhlFix> Duhl::start_fix(UhlFix all) {
       UhlFix others = solve(id);
       if (others.z.ok && others.explains) {
         available_.erase(id);
+        ++refused_start_txs_;
         return others;
       }
     }
   }
+  // Which one is wrong cannot be told (two Txs, or no Tx without which the others agree): every
+  // Tx is measured again.
+  refused_start_txs_ += available_.size();
   available_.clear();
-  uhl_failure_ = "the Txs' distances contradict each other (an echo)";
+  uhl_failure_ = "the Txs' distances contradicted each other (an echo): measured again";
   return std::nullopt;
 }
 
 void Duhl::observe() {
   pending_observation_ = false;
   if (available_.size() < kMinTxs) return;
-  std::optional<UhlFix> fix = solve(std::nullopt);
-  if (!fix->z.ok) {
-    uhl_failure_ = fix->z.failure;
+  const UhlFix fix = solve(std::nullopt);
+  if (!fix.z.ok) {
+    uhl_failure_ = fix.z.failure;
     return;
   }
   const StampNs now = *now_ns();
-  const bool restarting =
-      params_.reinitialize_after_gated > 0 && consecutive_gated_ + 1 >= params_.reinitialize_after_gated;
-  if (!has_pose() || restarting) {
-    fix = start_fix(std::move(*fix));
-    if (!fix) return;
-  }
-  const UhlSolution& z = fix->z;
-  const Cov3& r = fix->r;
   if (!has_pose()) {
-    ekf_.reset(z.pose, r);
+    const std::optional<UhlFix> checked = start_fix(fix);
+    if (!checked) return;
+    ekf_.reset(checked->z.pose, checked->r);
     start(now);
     consecutive_ranges_gated_ = 0;
     return;
   }
   // Eq. 17-20 with J_h,x = I.
-  const UpdateResult result = ekf_.update(PoseObservationModel(r), z.pose, params_.observation_nis_gate);
+  const UpdateResult result = ekf_.update(PoseObservationModel(fix.r), fix.z.pose, params_.observation_nis_gate);
   if (result.applied()) {
     corrected(now);
     consecutive_gated_ = 0;
   } else if (params_.reinitialize_after_gated > 0 &&
              ++consecutive_gated_ >= params_.reinitialize_after_gated) {
-    ekf_.reset(z.pose, r);  // the UHL and the filter disagree for too long: trust the beacons
+    // The UHL and the filter disagree for too long: trust the beacons, once their pose explains
+    // them (start_fix; until then the next UHL pose tries again).
+    const std::optional<UhlFix> checked = start_fix(fix);
+    if (!checked) return;
+    ekf_.reset(checked->z.pose, checked->r);
     corrected(now);
     consecutive_gated_ = 0;
+    consecutive_ranges_gated_ = 0;
   }
+}
+
+std::vector<Estimator::StateValue> Duhl::state_values() const {
+  return {{"tx_estimates_contradicted", static_cast<double>(contradicted_txs_), 0.0},
+          {"start_txs_refused", static_cast<double>(refused_start_txs_), 0.0}};
 }
 
 void Duhl::lose_track() {
@@ -306,7 +316,7 @@ StartupWait Duhl::waiting_for() const {
     return StartupWait{StartupCondition::kTooFewBeacons,
                        static_cast<double>(available_.size()),
                        static_cast<double>(kMinTxs),
-                       {}};
+                       refused_start_txs_ > 0 ? uhl_failure_ : std::string()};
   }
   return StartupWait{StartupCondition::kFixFailed, 0.0, 0.0, "uhl: " + uhl_failure_};
 }
@@ -332,12 +342,12 @@ InputResult UhlLast2::predict(const OdometrySample& o) {
   if (!pending_) return InputResult::ok();
   pending_ = false;
   // The last two Txs heard by all three receivers, each firing's distances possible for the
-  // ring (possible_distances: an echo's extra path breaks the triangle inequality).
+  // ring (update).
   std::vector<TxDistances> txs;
   std::vector<DistanceCov> covariances;
   for (auto it = firings_.rbegin(); it != firings_.rend() && txs.size() < kMinTxs; ++it) {
     if (!(it->heard[0] && it->heard[1] && it->heard[2])) continue;
-    if (!possible_distances(it->d, it->variance_m2, ring_)) continue;
+    if (it->impossible) continue;
     txs.push_back({map().find(it->beacon_id)->position_map_m, it->d});
     covariances.push_back(it->variance_m2 * DistanceCov::Identity());
   }
@@ -363,10 +373,18 @@ InputResult UhlLast2::update(const RangeMeasurement& r) {
     firings_.push_back({r.beacon_id, Distances::Zero()});
     if (firings_.size() > 8) firings_.erase(firings_.begin());
   }
-  firings_.back().d(r.receiver_id) = r.range_m;
-  firings_.back().heard[r.receiver_id] = true;
-  firings_.back().variance_m2 = r.variance_m2;
+  Firing& f = firings_.back();
+  f.d(r.receiver_id) = r.range_m;
+  f.heard[r.receiver_id] = true;
+  f.variance_m2 = r.variance_m2;
   pending_ = true;
+  // Not in the paper: the firing's three distances impossible for the ring (possible_distances:
+  // an echo's extra path breaks the triangle inequality) leave it out; the range that shows it
+  // is refused, so that it is counted.
+  if (f.heard[0] && f.heard[1] && f.heard[2] && !possible_distances(f.d, f.variance_m2, ring_)) {
+    f.impossible = true;
+    return InputResult::rejected(Rejection::kEchoOfFiring);
+  }
   return InputResult::ok();
 }
 

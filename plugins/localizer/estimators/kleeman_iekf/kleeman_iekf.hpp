@@ -121,7 +121,7 @@ class KleemanIekf final : public EstimatorBase {
   void remember(const kleeman::SlotPulse& pulse);
   kleeman::StartupFitSettings fit_settings() const;
   std::int64_t startup_slots_needed() const;
-  bool standing_in_window() const;  // the start-up window so far was driven less than the fit needs for a heading
+  bool standing_in_window() const;  // the start-up window so far moved the robot less than the fit needs for a heading
   // False (and the filter not started, the failure counted) when the fit's state is not finite.
   bool start_from_fit(const kleeman::StartupFit& fit, StampNs stamp_ns);
   // Counts a pulse in `slot`; too_many_pulses_in_slot past the cap.

@@ -24,10 +24,15 @@ std::int64_t KleemanIekf::startup_slots_needed() const {
   return std::max<std::int64_t>(cycles * static_cast<std::int64_t>(order_.size()), 12);
 }
 
+// As the fit tells a robot that moved (fit_startup: heading_observed): never further than
+// heading_observed_after_m from where it was at the window's first pulse.
 bool KleemanIekf::standing_in_window() const {
   if (!params_.dead_reckoning || window_.empty()) return false;  // without odometry it cannot be told
-  const kleeman::DeadReckoning d = track_.between(window_.front().arrival_s, window_.back().arrival_s);
-  return std::hypot(d.forward_m, d.left_m) < fit_settings().heading_observed_after_m;
+  const double limit_m = fit_settings().heading_observed_after_m;
+  return std::all_of(window_.begin(), window_.end(), [&](const kleeman::SlotPulse& p) {
+    const kleeman::DeadReckoning d = track_.between(window_.front().arrival_s, p.arrival_s);
+    return std::hypot(d.forward_m, d.left_m) < limit_m;
+  });
 }
 
 // The pulses after the first double burst, numbered by their slot from it with the nominal T (a

@@ -146,9 +146,10 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r, const Pose2& odom_pose_at_
   const RangeModel model = model_with(r.variance_m2);
   double variance_m2 = r.variance_m2;
   if (params_.learn_range_noise) {
-    // The range's noise as learnt so far (RangeNoiseScale), then this innovation learnt from.
+    // The range's noise as learnt so far (RangeNoiseScale), then this innovation learnt from,
+    // unless the ranges make the pose suspect: a filter that is off would teach a sigma too large.
     variance_m2 = noise_scale_.variance_m2(r.variance_m2);
-    with_filter([&](const auto& filter) {
+    if (!suspect_) with_filter([&](const auto& filter) {
       const auto lin = model.linearize(filter.state());
       noise_scale_.learn(r.range_m - lin.predicted(0), (lin.jacobian * filter.covariance() * lin.jacobian.transpose())(0, 0),
                          r.variance_m2);

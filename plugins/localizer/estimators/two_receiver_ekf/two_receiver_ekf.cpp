@@ -122,13 +122,17 @@ InputResult TwoReceiverEkf::update(const RangeMeasurement& r) {
   Ekf<2>& filter = receivers_[r.receiver_id];
   GateState& gate = gates_[r.receiver_id];
   double variance_m2 = r.variance_m2;
+  std::optional<double> declared_nis;  // of a range fused down-weighted: its NIS as declared
   if (!gate.closed && params_.open_gate_echo_sigma > 0.0) {  // TwoReceiverEkfParameters::open_gate_echo_sigma
     const PointRangeModel as_declared(receiver_z_m_, map().find(r.beacon_id)->position_map_m, r.variance_m2);
     const auto lin = as_declared.linearize(filter.state());
     const double innovation_m = r.range_m - lin.predicted(0);
     const double s_m2 = (lin.jacobian * filter.covariance() * lin.jacobian.transpose())(0, 0) + r.variance_m2;
     const double limit_m = params_.open_gate_echo_sigma * std::sqrt(s_m2);
-    if (innovation_m > limit_m) variance_m2 += (innovation_m * innovation_m / (limit_m * limit_m) - 1.0) * s_m2;
+    if (innovation_m > limit_m) {
+      variance_m2 += (innovation_m * innovation_m / (limit_m * limit_m) - 1.0) * s_m2;
+      declared_nis = innovation_m * innovation_m / s_m2;
+    }
   }
   const PointRangeModel model(receiver_z_m_, map().find(r.beacon_id)->position_map_m, variance_m2);
   const UpdateResult result = filter.update(
@@ -140,7 +144,8 @@ InputResult TwoReceiverEkf::update(const RangeMeasurement& r) {
   }
   if (!result.applied()) return InputResult::of(result.outcome);
   gate.gated = 0;
-  gate.agreeing = result.nis <= params_.nis_gate ? gate.agreeing + 1 : 0;
+  // Agreeing as declared: a down-weighted range's NIS is open_gate_echo_sigma^2 by construction.
+  gate.agreeing = declared_nis.value_or(result.nis) <= params_.nis_gate ? gate.agreeing + 1 : 0;
   if (gate.agreeing >= params_.gate_after_agreeing) gate.closed = true;
   corrected(std::max(r.stamp_ns, now_ns().value_or(r.stamp_ns)));
   return InputResult::ok();

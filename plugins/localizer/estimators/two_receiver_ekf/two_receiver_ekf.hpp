@@ -4,9 +4,10 @@
 // eq. 4-1: updated by each range to a ceiling generator at a known position, eq. 5-10), and the
 // robot's pose is taken from the pair (eq. 11) with the covariance eq. 12 gives
 // (receiver_pair.hpp). Placed by hand, as in the paper's experiment (Sec. 4: "the initial value
-// of the posture estimation are set arbitrary"). Not in the paper: of the two receivers' ranges
-// to one firing, one longer than the receivers' separation allows is refused as an echo
-// (ranges_of_one_firing_agree): until a receiver's gate closes, nothing else keeps an echo out.
+// of the posture estimation are set arbitrary"). Not in the paper (its ranges are direct): of the
+// two receivers' ranges to one firing, one longer than the receivers' separation allows is
+// refused as an echo (ranges_of_one_firing_agree), and until a receiver's gate closes a range
+// much longer than predicted is down-weighted (open_gate_echo_sigma).
 #include <array>
 #include <optional>
 

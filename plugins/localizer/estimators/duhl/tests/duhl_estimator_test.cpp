@@ -112,14 +112,19 @@ TEST(DuhlEstimator, ARobotCarriedAwayLosesItsPoseAndFindsItAgainFromTheBeacons) 
   robot.cycles(5);
   ASSERT_TRUE(robot.duhl_.estimate());
   robot.truth_ = Pose2(1.4, 0.2, -0.5);  // carried 0.9 m without odometry
+  const duhl::DuhlParameters defaults = duhl::DuhlParameters::from(ring_config());
   int gated = 0;
   while (robot.duhl_.estimate() && gated < 100) {
     for (std::uint32_t id = 1; id <= 3 && robot.duhl_.estimate(); ++id) {
       for (const InputResult& r : robot.fire(id)) gated += r.rejection == Rejection::kGatedNis ? 1 : 0;
       robot.slot();
+      // Never ok once the ranges refuse it: degraded, then dropped.
+      if (robot.duhl_.estimate() && gated >= defaults.suspect_after_gated_ranges) {
+        EXPECT_EQ(robot.duhl_.estimate()->status, PoseStatus::kDegraded) << gated;
+      }
     }
   }
-  EXPECT_EQ(gated, duhl::DuhlParameters::from(ring_config()).lost_after_gated_ranges);
+  EXPECT_EQ(gated, defaults.lost_after_gated_ranges);
   EXPECT_FALSE(robot.duhl_.estimate());  // the pose is dropped, not kept wrong
   robot.cycles(2);
   ASSERT_TRUE(robot.duhl_.estimate());
@@ -142,6 +147,36 @@ TEST(DuhlEstimator, DoesNotStartFromAUhlPoseAnEchoContradicts) {
   robot.slot();
   ASSERT_TRUE(robot.duhl_.estimate());
   EXPECT_LT(robot.position_error_m(), 1e-3);
+}
+
+TEST(UhlLast2, RefusesTheRangeThatCompletesAnImpossibleFiringAndPassesTheFiringOver) {
+  auto e = EstimatorRegistry::instance().create("uhl_last2", ring_config());
+  const BeaconMap map({{1, {0.0, 0.0, 2.0}}, {2, {2.0, 0.0, 2.0}}, {3, {1.0, 1.5, 2.0}}});
+  e->set_beacon_map(map);
+  const Pose2 truth(0.9, 0.5, 0.3);
+  StampNs t = 0;
+  const auto fire = [&](std::uint32_t id, double echo_on_receiver_2_m) {
+    std::vector<RangeMeasurement> ranges =
+        test_support::exact_ranges(truth, ReceiverArray::on_circle(0.19, 3), *map.find(id), t);
+    ranges[2].range_m += echo_on_receiver_2_m;
+    std::vector<InputResult> out;
+    for (const RangeMeasurement& r : ranges) out.push_back(e->update(r));
+    OdometrySample o;
+    t += 200'000'000;
+    o.stamp_ns = t;
+    o.wheel_base_m = 0.33;
+    e->predict(o);
+    return out;
+  };
+  fire(1, 0.0);
+  const std::vector<InputResult> echoed = fire(2, 0.8);
+  EXPECT_TRUE(echoed[0].accepted);
+  EXPECT_TRUE(echoed[1].accepted);
+  EXPECT_EQ(echoed[2].rejection, Rejection::kEchoOfFiring);
+  EXPECT_FALSE(e->estimate());  // the pair is Tx 1 and a firing it passes over: not two Txs yet
+  fire(3, 0.0);
+  ASSERT_TRUE(e->estimate());
+  EXPECT_LT((e->estimate()->pose_map_base.head<2>() - truth.head<2>()).norm(), 1e-3);
 }
 
 TEST(DuhlDistances, AFiringsDistancesMustBePossibleForTheRing) {

@@ -15,8 +15,8 @@ namespace beaconloc {
 
 class RangeNoiseScale {
  public:
-  // step: change of log k per range (0.02: about 50 ranges to move k by a fifth);
-  // k stays within [min_scale, max_scale].
+  // Each range moves log k by step / 2, up or down (0.02: 18 ranges that all agree move k by a
+  // fifth); k stays within [min_scale, max_scale].
   explicit RangeNoiseScale(double step = 0.02, double min_scale = 0.25, double max_scale = 4.0);
   // The variance to fuse a range of this declared variance with.
   double variance_m2(double declared_m2) const { return scale() * scale() * declared_m2; }
