@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "beaconloc/core/models/range_model.hpp"
+#include "beaconloc/core/receiver_array.hpp"
 
 namespace beaconloc::duhl {
 
@@ -117,6 +118,29 @@ DistanceInit initial_distances(const Pose2& pose, const Cov3& pose_covariance,
   }
   out.covariance = out.jacobian_pose * pose_covariance * out.jacobian_pose.transpose();  // eq. 29
   return out;
+}
+
+bool possible_distances(const Distances& d, double variance_m2, const ReceiverRing& ring) {
+  for (int a = 0; a < 3; ++a) {
+    for (int b = a + 1; b < 3; ++b) {
+      const double separation_m = (ring.receiver(a) - ring.receiver(b)).norm();
+      if (!ranges_of_one_firing_agree(d(a), d(b), separation_m, 2.0 * variance_m2)) return false;
+    }
+  }
+  return true;
+}
+
+bool explains_distances(const std::vector<TxBelief>& txs, const Pose2& pose, const Cov3& pose_covariance,
+                        const ReceiverRing& ring, double gate_sigma) {
+  for (const TxBelief& tx : txs) {
+    const DistanceInit expected = initial_distances(pose, pose_covariance, tx.tx_map_m, ring);
+    for (int l = 0; l < 3; ++l) {
+      const double sigmas =
+          std::abs(tx.q(l) - expected.q(l)) / std::sqrt(tx.covariance(l, l) + expected.covariance(l, l));
+      if (!(sigmas <= gate_sigma)) return false;  // a non-finite residual does not explain
+    }
+  }
+  return true;
 }
 
 }  // namespace beaconloc::duhl

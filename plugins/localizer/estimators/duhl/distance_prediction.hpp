@@ -3,6 +3,8 @@
 // receivers, predicted from odometry (eq. 23) with their covariance (eq. 24), corrected by a
 // measurement (eq. 25-27), initialized from the robot pose (eq. 28-29).
 #include <Eigen/Core>
+#include <optional>
+#include <vector>
 
 #include "beaconloc/core/pose2.hpp"
 
@@ -49,5 +51,21 @@ struct DistanceInit {
 };
 DistanceInit initial_distances(const Pose2& pose, const Cov3& pose_covariance,
                                const Eigen::Vector3d& tx_map_m, const ReceiverRing& ring);
+
+// Not in the paper: whether a pose explains the distances it was computed from (an echo makes
+// one Tx's distances contradict the others'): every distance within gate_sigma of the one the
+// pose predicts (eq. 28), in sigmas of the distance's variance plus the prediction's (eq. 29).
+inline constexpr double kDefaultResidualGateSigma = 4.0;
+struct TxBelief {
+  Eigen::Vector3d tx_map_m;
+  Distances q;
+  DistanceCov covariance;
+};
+bool explains_distances(const std::vector<TxBelief>& txs, const Pose2& pose, const Cov3& pose_covariance,
+                        const ReceiverRing& ring, double gate_sigma);
+
+// The triangle inequality between each two receivers and a Tx (ranges_of_one_firing_agree):
+// false when an echo made one distance too long (or a distance is not finite).
+bool possible_distances(const Distances& d, double variance_m2, const ReceiverRing& ring);
 
 }  // namespace beaconloc::duhl

@@ -72,6 +72,11 @@ DuhlParameters DuhlParameters::from(const EstimatorConfig& c) {
       in.flag("observation_covariance_as_printed", p.observation_covariance_as_printed);
   p.distance_innovation_gate =
       in.real("distance_innovation_gate", p.distance_innovation_gate, ranges::kChiSquareGateOrOff);
+  p.range_pose_gate = in.real("range_pose_gate", p.range_pose_gate, ranges::kChiSquareGateOrOff);
+  p.suspect_after_gated_ranges = in.count("suspect_after_gated_ranges", p.suspect_after_gated_ranges, 1, 1000);
+  p.lost_after_gated_ranges = in.count("lost_after_gated_ranges", p.lost_after_gated_ranges, 1, 1000);
+  p.start_residual_gate_sigma =
+      in.real("start_residual_gate_sigma", p.start_residual_gate_sigma, ParameterRange::above(0.0, 100.0));
   in.finish();
   return p;
 }
@@ -122,6 +127,20 @@ InputResult Duhl::predict(const OdometrySample& o) {
 
 InputResult Duhl::update(const RangeMeasurement& r) {
   if (const InputResult checked = check_range(r, map(), 3); !checked.accepted) return checked;
+  if (has_pose() && params_.range_pose_gate > 0.0) {
+    // Not in the paper: an echo. The distance the pose predicts (eq. 28) with its variance
+    // (eq. 29), not the Tx's own estimate q^i: that one may have drifted (the gate below), the
+    // pose is what every Tx agrees on.
+    const DistanceInit expected = initial_distances(ekf_.state(), ekf_.covariance(),
+                                                    map().find(r.beacon_id)->position_map_m, ring_);
+    const double innovation_m = r.range_m - expected.q(r.receiver_id);
+    const double variance_m2 = expected.covariance(r.receiver_id, r.receiver_id) + r.variance_m2;
+    if (innovation_m * innovation_m > params_.range_pose_gate * variance_m2) {
+      if (++consecutive_ranges_gated_ >= params_.lost_after_gated_ranges) lose_track();
+      return InputResult::rejected(Rejection::kGatedNis);
+    }
+    consecutive_ranges_gated_ = 0;
+  }
   auto it = available_.find(r.beacon_id);
   if (it != available_.end() && params_.distance_innovation_gate > 0.0) {
     // Not in the paper: an estimate its own measurement contradicts (at 1.02 m/s a turn can
@@ -188,51 +207,106 @@ std::optional<Duhl::TxEstimate> Duhl::new_tx_estimate(const RangeMeasurement& r,
 // So R here propagates only the measurement part of Q^i (TxEstimate::measurement_covariance)
 // and scales it by |T_A|, so that over the corrections that reuse a measurement it carries its
 // information once (covariance intersection's equal split).
-Cov3 Duhl::observation_covariance(const std::vector<TxDistances>& txs, const UhlSolution& z) const {
+Duhl::UhlFix Duhl::solve(std::optional<std::uint32_t> left_out) const {
+  std::vector<TxDistances> txs;
   std::vector<DistanceCov> covariances;
-  covariances.reserve(available_.size());
-  const double reuse = static_cast<double>(available_.size());
+  std::vector<TxBelief> beliefs;
+  // |T_A| of the Txs this solve takes (see observation R above).
+  const double reuse = static_cast<double>(available_.size() - (left_out && available_.count(*left_out) ? 1 : 0));
   for (const auto& [id, e] : available_) {
+    if (id == left_out) continue;
+    const Eigen::Vector3d& tx_map_m = map().find(id)->position_map_m;
+    txs.push_back({tx_map_m, e.q()});
     covariances.push_back(params_.observation_covariance_as_printed ? e.covariance()
                                                                     : reuse * e.measurement_covariance);
+    beliefs.push_back({tx_map_m, e.q(), e.covariance()});
   }
-  return uhl_observation_covariance(txs, z, covariances, params_.uhl) + 1e-9 * Cov3::Identity();
+  UhlFix fix;
+  if (txs.size() < kMinTxs) {
+    fix.z.failure = "fewer than two Txs";
+    return fix;
+  }
+  fix.z = solve_uhl(txs, params_.uhl);
+  if (!fix.z.ok) return fix;
+  fix.r = uhl_observation_covariance(txs, fix.z, covariances, params_.uhl) + 1e-9 * Cov3::Identity();
+  fix.explains = explains_distances(beliefs, fix.z.pose, fix.r, ring_, params_.start_residual_gate_sigma);
+  return fix;
+}
+
+// Not in the paper: a UHL pose from an echo. Before the filter is (re)started from a pose, the
+// pose must explain every Tx's distances.
+std::optional<Duhl::UhlFix> Duhl::start_fix(UhlFix all) {
+  if (all.explains) return all;
+  if (available_.size() > kMinTxs) {
+    for (const auto& entry : available_) {
+      const std::uint32_t id = entry.first;
+      UhlFix others = solve(id);
+      if (others.z.ok && others.explains) {
+        available_.erase(id);
+        ++refused_start_txs_;
+        return others;
+      }
+    }
+  }
+  // Which one is wrong cannot be told (two Txs, or no Tx without which the others agree): every
+  // Tx is measured again.
+  refused_start_txs_ += available_.size();
+  available_.clear();
+  uhl_failure_ = "the Txs' distances contradicted each other (an echo): measured again";
+  return std::nullopt;
 }
 
 void Duhl::observe() {
   pending_observation_ = false;
   if (available_.size() < kMinTxs) return;
-  std::vector<TxDistances> txs;
-  txs.reserve(available_.size());
-  for (const auto& [id, e] : available_) txs.push_back({map().find(id)->position_map_m, e.q()});
-  const UhlSolution z = solve_uhl(txs, params_.uhl);
-  if (!z.ok) {
-    uhl_failure_ = z.failure;
+  const UhlFix fix = solve(std::nullopt);
+  if (!fix.z.ok) {
+    uhl_failure_ = fix.z.failure;
     return;
   }
-  const Cov3 r = observation_covariance(txs, z);
   const StampNs now = *now_ns();
   if (!has_pose()) {
-    ekf_.reset(z.pose, r);
+    const std::optional<UhlFix> checked = start_fix(fix);
+    if (!checked) return;
+    ekf_.reset(checked->z.pose, checked->r);
     start(now);
+    consecutive_ranges_gated_ = 0;
     return;
   }
   // Eq. 17-20 with J_h,x = I.
-  const UpdateResult result = ekf_.update(PoseObservationModel(r), z.pose, params_.observation_nis_gate);
+  const UpdateResult result = ekf_.update(PoseObservationModel(fix.r), fix.z.pose, params_.observation_nis_gate);
   if (result.applied()) {
     corrected(now);
     consecutive_gated_ = 0;
   } else if (params_.reinitialize_after_gated > 0 &&
              ++consecutive_gated_ >= params_.reinitialize_after_gated) {
-    ekf_.reset(z.pose, r);  // the UHL and the filter disagree for too long: trust the beacons
+    // The UHL and the filter disagree for too long: trust the beacons, once their pose explains
+    // them (start_fix; until then the next UHL pose tries again).
+    const std::optional<UhlFix> checked = start_fix(fix);
+    if (!checked) return;
+    ekf_.reset(checked->z.pose, checked->r);
     corrected(now);
     consecutive_gated_ = 0;
+    consecutive_ranges_gated_ = 0;
   }
+}
+
+std::vector<Estimator::StateValue> Duhl::state_values() const {
+  return {{"tx_estimates_contradicted", static_cast<double>(contradicted_txs_), 0.0},
+          {"start_txs_refused", static_cast<double>(refused_start_txs_), 0.0}};
+}
+
+void Duhl::lose_track() {
+  forget_pose();  // found again from the beacons alone, as at the start
+  available_.clear();
+  consecutive_gated_ = 0;
+  consecutive_ranges_gated_ = 0;
 }
 
 bool Duhl::place(const Pose2& pose, const Cov3& covariance) {
   ekf_.reset(pose, covariance);  // the distance estimates stay: they come from the measurements
   consecutive_gated_ = 0;
+  consecutive_ranges_gated_ = 0;
   return true;
 }
 
@@ -242,7 +316,7 @@ StartupWait Duhl::waiting_for() const {
     return StartupWait{StartupCondition::kTooFewBeacons,
                        static_cast<double>(available_.size()),
                        static_cast<double>(kMinTxs),
-                       {}};
+                       refused_start_txs_ > 0 ? uhl_failure_ : std::string()};
   }
   return StartupWait{StartupCondition::kFixFailed, 0.0, 0.0, "uhl: " + uhl_failure_};
 }
@@ -267,11 +341,13 @@ InputResult UhlLast2::predict(const OdometrySample& o) {
   if (!step.result.accepted) return step.result;
   if (!pending_) return InputResult::ok();
   pending_ = false;
-  // The last two Txs heard by all three receivers.
+  // The last two Txs heard by all three receivers, each firing's distances possible for the
+  // ring (update).
   std::vector<TxDistances> txs;
   std::vector<DistanceCov> covariances;
   for (auto it = firings_.rbegin(); it != firings_.rend() && txs.size() < kMinTxs; ++it) {
     if (!(it->heard[0] && it->heard[1] && it->heard[2])) continue;
+    if (it->impossible) continue;
     txs.push_back({map().find(it->beacon_id)->position_map_m, it->d});
     covariances.push_back(it->variance_m2 * DistanceCov::Identity());
   }
@@ -297,10 +373,18 @@ InputResult UhlLast2::update(const RangeMeasurement& r) {
     firings_.push_back({r.beacon_id, Distances::Zero()});
     if (firings_.size() > 8) firings_.erase(firings_.begin());
   }
-  firings_.back().d(r.receiver_id) = r.range_m;
-  firings_.back().heard[r.receiver_id] = true;
-  firings_.back().variance_m2 = r.variance_m2;
+  Firing& f = firings_.back();
+  f.d(r.receiver_id) = r.range_m;
+  f.heard[r.receiver_id] = true;
+  f.variance_m2 = r.variance_m2;
   pending_ = true;
+  // Not in the paper: the firing's three distances impossible for the ring (possible_distances:
+  // an echo's extra path breaks the triangle inequality) leave it out; the range that shows it
+  // is refused, so that it is counted.
+  if (f.heard[0] && f.heard[1] && f.heard[2] && !possible_distances(f.d, f.variance_m2, ring_)) {
+    f.impossible = true;
+    return InputResult::rejected(Rejection::kEchoOfFiring);
+  }
   return InputResult::ok();
 }
 

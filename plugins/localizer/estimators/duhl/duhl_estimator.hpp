@@ -42,6 +42,23 @@ struct DuhlParameters {
   // variances (chi-square, 1 dof, 99.9 %) discards the Tx's estimate, which is then initialized
   // anew from the pose (eq. 28-29) and corrected with the measurement; 0: never. Not in the paper.
   double distance_innovation_gate = kChiSquare999OneDof;
+  // Echoes (not in the paper, whose ranges are all direct): once there is a pose, a measured
+  // distance whose squared innovation against the distance the pose predicts (eq. 28, its
+  // variance eq. 29 plus the measurement's) exceeds this many variances is refused as gated;
+  // 0: never. 25: 5 sigma, wider than chi-square's 99.9 % (10.83), which refused direct
+  // distances in turns (docs/accuracy-seed000.md, departure 4). An echo's extra path (0.3 m and
+  // more) is many sigmas.
+  double range_pose_gate = 25.0;
+  // Distances refused by range_pose_gate in a row before the pose is suspect (published
+  // degraded: two firings' worth), and before it is dropped and found again from the beacons, as
+  // at the start (15: a second of ranges from three receivers at 5 Hz).
+  int suspect_after_gated_ranges = 6;
+  int lost_after_gated_ranges = 15;
+  // Before a UHL pose is used to start (or restart) the filter, every Tx's distances must be
+  // within this many sigmas of the distances the pose predicts; otherwise the Tx without which
+  // the others agree is dropped, or, when there is none, every Tx (the next firings measure
+  // them again), and the start waits.
+  double start_residual_gate_sigma = kDefaultResidualGateSigma;
 
   static DuhlParameters from(const EstimatorConfig& config);
 };
@@ -56,12 +73,16 @@ class Duhl final : public EstimatorBase {
   std::size_t available_txs() const { return available_.size(); }
   // Tx estimates discarded because their own measurement contradicted them (distance_innovation_gate).
   std::uint64_t contradicted_txs() const { return contradicted_txs_; }
+  // Tx estimates dropped because a start's UHL pose could not explain them (echoes).
+  std::uint64_t refused_start_txs() const { return refused_start_txs_; }
+  std::vector<StateValue> state_values() const override;
 
  private:
   Duhl(const EstimatorConfig& config, const DuhlParameters& params);
   PoseBelief pose_belief() const override { return {ekf_.state(), ekf_.covariance()}; }
   StartupWait waiting_for() const override;
   bool place(const Pose2& pose_map_base, const Cov3& covariance) override;
+  bool suspect() const override { return consecutive_ranges_gated_ >= params_.suspect_after_gated_ranges; }
   struct TxEstimate {
     // q^i and Q^i (eq. 23-24, 25-27): the belief of this Tx's own Kalman filter, which the
     // range updates correct in place.
@@ -76,7 +97,18 @@ class Duhl final : public EstimatorBase {
   // q^i and Q^i of a Tx not in T_A (eq. 28-30); nullopt (with the filter's outcome) when they
   // are not finite.
   std::optional<TxEstimate> new_tx_estimate(const RangeMeasurement& range, FilterOutcome& outcome) const;
-  Cov3 observation_covariance(const std::vector<TxDistances>& txs, const UhlSolution& z) const;
+  // The UHL pose of the Txs of T_A but left_out (eq. 4-13), its R (eq. 21) and whether it
+  // explains every one of those Txs' distances (explains_distances).
+  struct UhlFix {
+    UhlSolution z;
+    Cov3 r = Cov3::Identity();
+    bool explains = false;
+  };
+  UhlFix solve(std::optional<std::uint32_t> left_out) const;
+  // At a (re)start: the fix of every Tx, or of all but the one an echo spoiled (the others'
+  // fix explains their distances); nullopt, with the Txs forgotten, when neither is found.
+  std::optional<UhlFix> start_fix(UhlFix all);
+  void lose_track();
 
   ReceiverRing ring_;
   DuhlParameters params_;
@@ -84,11 +116,15 @@ class Duhl final : public EstimatorBase {
   std::map<std::uint32_t, TxEstimate> available_;  // T_A and Q (eq. 30)
   bool pending_observation_ = false;
   int consecutive_gated_ = 0;
+  int consecutive_ranges_gated_ = 0;
   std::uint64_t contradicted_txs_ = 0;
+  std::uint64_t refused_start_txs_ = 0;
   std::string uhl_failure_;  // why the last UHL solve failed
 };
 
 // The paper's baseline: UHL on the distances last measured from the last two Txs, no odometry.
+// Not in the paper: a firing whose distances are impossible for the ring (possible_distances,
+// an echo) is passed over, the range that completes it refused as echo_of_firing.
 class UhlLast2 final : public EstimatorBase {
  public:
   explicit UhlLast2(const EstimatorConfig& config);
@@ -106,6 +142,7 @@ class UhlLast2 final : public EstimatorBase {
     Distances d;
     std::array<bool, 3> heard{false, false, false};
     double variance_m2 = 1e-4;
+    bool impossible = false;  // its distances break the triangle inequality: an echo among them
   };
   ReceiverRing ring_;
   UhlOptions uhl_;

@@ -55,6 +55,7 @@ KleemanParameters KleemanParameters::from(const EstimatorConfig& c) {
   p.echo_gate_probability =
       in.real("echo_gate_probability", p.echo_gate_probability, ParameterRange::open(0.0, 1.0));
   p.startup_cycles = in.count("startup_cycles", p.startup_cycles, 1, 20);
+  p.standing_startup_cycles = in.count("standing_startup_cycles", p.standing_startup_cycles, 1, 20);
   p.unknown_speed_mps = in.real("unknown_speed_mps", p.unknown_speed_mps, ParameterRange::above(0.0, 10.0));
   p.heading_fit_cycles = in.count("heading_fit_cycles", p.heading_fit_cycles, 1, 20);
   p.heading_fit_min_travel_m =

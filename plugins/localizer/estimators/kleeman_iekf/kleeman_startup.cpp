@@ -17,9 +17,22 @@ constexpr Eigen::Index at(Fit p) { return static_cast<Eigen::Index>(p); }
 }  // namespace
 
 std::int64_t KleemanIekf::startup_slots_needed() const {
-  // startup_cycles cycles, and at least 12 slots: a map of few beacons needs more of their cycles
-  // for the fit's six unknowns (three of them with priors).
-  return std::max<std::int64_t>(params_.startup_cycles * static_cast<std::int64_t>(order_.size()), 12);
+  // startup_cycles cycles (standing_startup_cycles while the robot stands), and at least 12
+  // slots: a map of few beacons needs more of their cycles for the fit's six unknowns (three of
+  // them with priors).
+  const int cycles = standing_in_window() ? params_.standing_startup_cycles : params_.startup_cycles;
+  return std::max<std::int64_t>(cycles * static_cast<std::int64_t>(order_.size()), 12);
+}
+
+// As the fit tells a robot that moved (fit_startup: heading_observed): never further than
+// heading_observed_after_m from where it was at the window's first pulse.
+bool KleemanIekf::standing_in_window() const {
+  if (!params_.dead_reckoning || window_.empty()) return false;  // without odometry it cannot be told
+  const double limit_m = fit_settings().heading_observed_after_m;
+  return std::all_of(window_.begin(), window_.end(), [&](const kleeman::SlotPulse& p) {
+    const kleeman::DeadReckoning d = track_.between(window_.front().arrival_s, p.arrival_s);
+    return std::hypot(d.forward_m, d.left_m) < limit_m;
+  });
 }
 
 // The pulses after the first double burst, numbered by their slot from it with the nominal T (a

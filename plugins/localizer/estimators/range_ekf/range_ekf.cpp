@@ -16,9 +16,6 @@
 namespace beaconloc {
 
 namespace {
-// Arrivals of one firing at the receivers of one robot: within the time sound takes to cross the
-// robot (0.4 m / 343 m/s = 1.2 ms), far less than the 200 ms between two firings.
-constexpr StampNs kSameFiringNs = 20 * kNsPerMillisecond;
 // One pose is preferred to another (a global fix to its mirror image, a fix to a suspect
 // filter pose) when it fits the same ranges better by this much weighted squared residual.
 // Whichever of two poses is the robot's, noise makes the other fit better by T with probability
@@ -54,6 +51,7 @@ RangeEkfParameters RangeEkfParameters::from(const EstimatorConfig& c) {
   p.divergence_gated_ranges =
       in.count("divergence_gated_ranges", p.divergence_gated_ranges, 1, p.divergence_window_ranges);
   p.range_calibration = in.count("range_calibration", p.range_calibration, 0, 2);
+  p.learn_range_noise = in.flag("learn_range_noise", p.learn_range_noise);
   p.range_scale_sigma = in.real("range_scale_sigma", p.range_scale_sigma,
                                 ParameterRange::above(0.0, RangeCalibrationStates::kMaxScaleSigma));
   p.range_bias_sigma_m = in.real("range_bias_sigma_m", p.range_bias_sigma_m, ParameterRange::above(0.0, 100.0));
@@ -138,11 +136,28 @@ Pose2 RangeEkf::odom_pose_at(StampNs stamp_ns) const {
 InputResult RangeEkf::fuse(const RangeMeasurement& r, const Pose2& odom_pose_at_range) {
   const Beacon& beacon = *map().find(r.beacon_id);
   const Pose2 then_in_now = between(odom_pose_, odom_pose_at_range);
-  const RangeModel model(transform_point(then_in_now, receivers_.receivers_base_m[r.receiver_id]),
-                         receivers_.receiver_height_m, beacon.position_map_m, r.variance_m2, PoseIndex{},
-                         calibration_.enabled() ? calibration_of(r.beacon_id) : RangeCalibrationIndex{});
-  const UpdateResult result = with_filter(
-      [&](auto& filter) { return filter.update(model, RangeModel::Vector(r.range_m), params_.nis_gate); });
+  const Eigen::Vector2d receiver_now_m = transform_point(then_in_now, receivers_.receivers_base_m[r.receiver_id]);
+  const RangeCalibrationIndex calibration =
+      calibration_.enabled() ? calibration_of(r.beacon_id) : RangeCalibrationIndex{};
+  const auto model_with = [&](double variance_m2) {
+    return RangeModel(receiver_now_m, receivers_.receiver_height_m, beacon.position_map_m, variance_m2, PoseIndex{},
+                      calibration);
+  };
+  const RangeModel model = model_with(r.variance_m2);
+  double variance_m2 = r.variance_m2;
+  if (params_.learn_range_noise) {
+    // The range's noise as learnt so far (RangeNoiseScale), then this innovation learnt from,
+    // unless the ranges make the pose suspect: a filter that is off would teach a sigma too large.
+    variance_m2 = noise_scale_.variance_m2(r.variance_m2);
+    if (!suspect_) with_filter([&](const auto& filter) {
+      const auto lin = model.linearize(filter.state());
+      noise_scale_.learn(r.range_m - lin.predicted(0), (lin.jacobian * filter.covariance() * lin.jacobian.transpose())(0, 0),
+                         r.variance_m2);
+    });
+  }
+  const UpdateResult result = with_filter([&](auto& filter) {
+    return filter.update(model_with(variance_m2), RangeModel::Vector(r.range_m), params_.nis_gate);
+  });
   static_assert(RangeModel::kSize == 1, "log 2 pi is the constant of a 1-D Gaussian");
   if (result.outcome == FilterOutcome::kApplied || result.outcome == FilterOutcome::kGated) {
     const double nis = result.outcome == FilterOutcome::kGated ? params_.nis_gate : result.nis;
@@ -299,9 +314,7 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
                    {}};
     return out;
   }
-  // Echoes, screened by geometry alone: two receivers d apart hearing one firing measure ranges
-  // that differ by at most d (triangle inequality); an echo's path is longer, so of a pair that
-  // differs by more, the longer range is the echo. O(n^2) over a window of at most
+  // Echoes, screened by geometry alone (ranges_of_one_firing_agree). O(n^2) over a window of at most
   // kMaxWindowRanges (not in strict stamp order: ranges a little ahead of the odometry are
   // taken as they arrive).
   std::vector<bool> echo(window_.size(), false);
@@ -315,7 +328,7 @@ RangeEkf::WindowFix RangeEkf::window_fix() const {
       }
       const double baseline_m =
           (receivers_.receivers_base_m[a.receiver_id] - receivers_.receivers_base_m[b.receiver_id]).norm();
-      if (std::abs(a.range_m - b.range_m) > baseline_m + 3.0 * std::sqrt(a.variance_m2 + b.variance_m2)) {
+      if (!ranges_of_one_firing_agree(a.range_m, b.range_m, baseline_m, a.variance_m2 + b.variance_m2)) {
         echo[a.range_m > b.range_m ? i : j] = true;
       }
     }
@@ -449,6 +462,7 @@ std::vector<Estimator::StateValue> RangeEkf::state_values() const {
   if (innovations_ > 0) {
     out.push_back({"range_innovation_nll_nats", innovation_nll_sum_ / static_cast<double>(innovations_), 0.0});
   }
+  if (params_.learn_range_noise) out.push_back({"range_noise_scale", noise_scale_.scale(), 0.0});
   if (!calibration_.enabled()) return out;
   const std::vector<StateValue> calibration = calibration_.values(calibrating_.state(), calibrating_.covariance());
   out.insert(out.end(), calibration.begin(), calibration.end());

@@ -14,6 +14,7 @@
 #include "beaconloc/core/estimator_base.hpp"
 #include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/filters/ekf.hpp"
+#include "beaconloc/core/models/range_noise_scale.hpp"
 #include "beaconloc/core/solvers/range_pose_solver.hpp"
 #include "range_ekf/range_calibration.hpp"
 
@@ -69,6 +70,10 @@ struct RangeEkfParameters {
   int range_calibration = 0;
   double range_scale_sigma = 0.1;
   double range_bias_sigma_m = 0.5;
+  // The ranges' noise learnt online as k times each range's declared sigma (RangeNoiseScale:
+  // the median of the innovations), instead of taken as declared: a sensor whose sigma is not
+  // known, or not what its datasheet says (docs/range-noise.md).
+  bool learn_range_noise = false;
 
   static RangeEkfParameters from(const EstimatorConfig& config);
 };
@@ -151,6 +156,7 @@ class RangeEkf final : public EstimatorBase {
   // echo weighs no more than a range at the gate).
   double innovation_nll_sum_ = 0.0;
   std::uint64_t innovations_ = 0;
+  RangeNoiseScale noise_scale_;  // learn_range_noise
   Ekf<3> ekf_{pose_space()};
   RangeCalibrationStates calibration_;
   Ekf<Eigen::Dynamic> calibrating_{StateSpace<Eigen::Dynamic>::with_pose({}, RangeCalibrationStates::kPoseSize)};

@@ -20,6 +20,8 @@ TwoReceiverEkfParameters TwoReceiverEkfParameters::from(const EstimatorConfig& c
   p.initial_sigma_rad = in.real("initial_sigma_rad", p.initial_sigma_rad, ranges::kHeadingSigmaRad);
   p.nis_gate = in.real("nis_gate", p.nis_gate, ranges::kChiSquareGate);
   p.gate_after_agreeing = in.count("gate_after_agreeing", p.gate_after_agreeing, 1, 1000);
+  p.open_gate_echo_sigma =
+      in.real("open_gate_echo_sigma", p.open_gate_echo_sigma, ParameterRange::closed(0.0, 100.0));
   p.separation_gate_sigma =
       in.real("separation_gate_sigma", p.separation_gate_sigma, ParameterRange::above(0.0, 100.0));
   p.max_odometry_gap_s = in.real("max_odometry_gap_s", p.max_odometry_gap_s, ranges::kDataDurationS);
@@ -107,9 +109,32 @@ InputResult TwoReceiverEkf::predict(const OdometrySample& o) {
 InputResult TwoReceiverEkf::update(const RangeMeasurement& r) {
   if (const InputResult checked = check_range(r, map(), 2); !checked.accepted) return checked;
   if (!has_pose()) return InputResult::rejected(Rejection::kNoInitialPose);
+  // The other receiver heard the same firing first when its path is shorter: an echo here is
+  // the longer one of the pair. (Heard first, an echo cannot be told: the direct range after it
+  // is shorter.)
+  const std::optional<RangeMeasurement>& other = last_heard_[1 - r.receiver_id];
+  last_heard_[r.receiver_id] = r;
+  if (other && other->beacon_id == r.beacon_id && std::abs(r.stamp_ns - other->stamp_ns) <= kSameFiringNs &&
+      r.range_m > other->range_m &&
+      !ranges_of_one_firing_agree(r.range_m, other->range_m, pair_.separation_m(), r.variance_m2 + other->variance_m2)) {
+    return InputResult::rejected(Rejection::kEchoOfFiring);
+  }
   Ekf<2>& filter = receivers_[r.receiver_id];
   GateState& gate = gates_[r.receiver_id];
-  const PointRangeModel model(receiver_z_m_, map().find(r.beacon_id)->position_map_m, r.variance_m2);
+  double variance_m2 = r.variance_m2;
+  std::optional<double> declared_nis;  // of a range fused down-weighted: its NIS as declared
+  if (!gate.closed && params_.open_gate_echo_sigma > 0.0) {  // TwoReceiverEkfParameters::open_gate_echo_sigma
+    const PointRangeModel as_declared(receiver_z_m_, map().find(r.beacon_id)->position_map_m, r.variance_m2);
+    const auto lin = as_declared.linearize(filter.state());
+    const double innovation_m = r.range_m - lin.predicted(0);
+    const double s_m2 = (lin.jacobian * filter.covariance() * lin.jacobian.transpose())(0, 0) + r.variance_m2;
+    const double limit_m = params_.open_gate_echo_sigma * std::sqrt(s_m2);
+    if (innovation_m > limit_m) {
+      variance_m2 += (innovation_m * innovation_m / (limit_m * limit_m) - 1.0) * s_m2;
+      declared_nis = innovation_m * innovation_m / s_m2;
+    }
+  }
+  const PointRangeModel model(receiver_z_m_, map().find(r.beacon_id)->position_map_m, variance_m2);
   const UpdateResult result = filter.update(
       model, PointRangeModel::Vector(r.range_m), gate.closed ? params_.nis_gate : std::numeric_limits<double>::infinity());
   if (result.outcome == FilterOutcome::kGated) {
@@ -119,7 +144,8 @@ InputResult TwoReceiverEkf::update(const RangeMeasurement& r) {
   }
   if (!result.applied()) return InputResult::of(result.outcome);
   gate.gated = 0;
-  gate.agreeing = result.nis <= params_.nis_gate ? gate.agreeing + 1 : 0;
+  // Agreeing as declared: a down-weighted range's NIS is open_gate_echo_sigma^2 by construction.
+  gate.agreeing = declared_nis.value_or(result.nis) <= params_.nis_gate ? gate.agreeing + 1 : 0;
   if (gate.agreeing >= params_.gate_after_agreeing) gate.closed = true;
   corrected(std::max(r.stamp_ns, now_ns().value_or(r.stamp_ns)));
   return InputResult::ok();

@@ -13,6 +13,7 @@
 #include "kleeman_iekf/odometry_track.hpp"
 #include "kleeman_iekf/startup_fit.hpp"
 #include "offline_run.hpp"
+#include "sim/faults.hpp"
 #include "sim/scenario_yaml.hpp"
 
 namespace beaconloc {
@@ -248,6 +249,34 @@ TEST(KleemanIekf, AStandingRobotIsLocalizedWithItsHeadingUnknownAndDegradedUntil
   EXPECT_EQ(last.status, PoseStatus::kOk);
   EXPECT_LT(std::abs(wrap_angle_rad(last.pose_map_base.z() - truth.z())), 0.2);
   EXPECT_GE(dynamic_cast<const KleemanIekf&>(*r.estimator).heading_fits(), 1u);
+}
+
+// A standing robot's start-up fit takes three cycles (standing_startup_cycles), a moving one's
+// two: with 30 % echoes, seed 6's standing robot had a beacon echoed in both of its first two
+// cycles, which the fit took for consistent and started 0.86 m off.
+TEST(KleemanIekf, AStandingRobotsStartUpFitTakesAThirdCycleAndOutlastsAnEchoedBeacon) {
+  sim::Scenario s = seed002();
+  sim::apply_fault(s, "echoes=0.3");
+  const auto first_pose_s = [](const PulseRun& r) { return ns_to_s(r.poses.front().second.stamp_ns); };
+  const auto worst_error_m = [](const PulseRun& r, double from_s, double to_s) {
+    double worst = 0.0;
+    for (const auto& [truth, est] : r.poses) {
+      const double t = ns_to_s(est.stamp_ns);
+      if (t >= from_s && t <= to_s) worst = std::max(worst, (truth.head<2>() - est.pose_map_base.head<2>()).norm());
+    }
+    return worst;
+  };
+  const PulseRun two = run(s, 6, 15.0, {}, {}, {"standing_startup_cycles=2"});
+  const PulseRun three = run(s, 6, 15.0);
+  ASSERT_FALSE(two.poses.empty());
+  ASSERT_FALSE(three.poses.empty());
+  EXPECT_NEAR(first_pose_s(three) - first_pose_s(two), 6 * 0.15, 0.05);  // one cycle of six slots later
+  // Still standing (it drives from 15 s): two cycles start 0.86 m off and are still off at 12 s;
+  // three start a third of that off (the echoes under the fit's gate) and close in.
+  EXPECT_GT(worst_error_m(two, 0.0, 15.0), 0.8);
+  EXPECT_GT(worst_error_m(two, 12.0, 15.0), 0.5);
+  EXPECT_LT(worst_error_m(three, 0.0, 15.0), 0.35);
+  EXPECT_LT(worst_error_m(three, 12.0, 15.0), 0.1);
 }
 
 TEST(KleemanIekf, AMissedPulseIsCountedAndSurvivedAndAnEchoGated) {

@@ -4,7 +4,24 @@
 #include <cmath>
 #include <vector>
 
+#include "beaconloc/core/time.hpp"
+
 namespace beaconloc {
+
+// Two receivers' ranges to one firing arrive within this of each other: within the time sound
+// takes to cross the robot (0.4 m / 343 m/s = 1.2 ms), far less than the 100-200 ms between two
+// firings.
+inline constexpr StampNs kSameFiringNs = 20 * kNsPerMillisecond;
+// Slack of the triangle inequality below, in sigmas of the two ranges' difference.
+inline constexpr double kTriangleSlackSigma = 3.0;
+
+// Echoes, told by geometry alone: two receivers baseline_m apart hearing one firing measure
+// ranges that differ by at most baseline_m (triangle inequality). An echo's path is longer: of a
+// pair that differs by more, the longer range is the echo. False also for a non-finite range.
+inline bool ranges_of_one_firing_agree(double range_a_m, double range_b_m, double baseline_m,
+                                       double variance_sum_m2) {
+  return std::abs(range_a_m - range_b_m) <= baseline_m + kTriangleSlackSigma * std::sqrt(variance_sum_m2);
+}
 
 struct ReceiverArray {
   std::vector<Eigen::Vector2d> receivers_base_m;  // index = receiver id

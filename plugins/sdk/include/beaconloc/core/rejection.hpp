@@ -60,6 +60,7 @@ enum class Rejection : std::uint8_t {
   kAheadOfOdometry,
   // A filter's update or prediction not applied (core/filters/outcome.hpp).
   kGatedNis,
+  kEchoOfFiring,  // longer than another receiver's range of the same firing allows (ranges_of_one_firing_agree)
   kSingularInnovation,
   kCovarianceNotPositiveDefinite,
   kHInfinityBoundNotMet,

@@ -1,0 +1,91 @@
+// Issue 18, item 4: every estimator on its paper's setup under the simulator's echoes (each TOF
+// an echo with probability P, 0.3-3 m of extra path), ten seeds, every faulty run next to the
+// clean run of the same seed. Asserted: the mean E_p RMS at most 1.5 times the clean one, and no
+// seed that loses track (its E_p RMS more than kLostRatio times its own clean run's).
+//   beaconloc accuracy --scenario examples/scenarios/SCENARIO.yaml --estimator E --seeds 10 --fault echoes=P
+// prints the same figures (docs/robustness.md, "Echoes, every estimator").
+// Not asserted, because not met yet (printed by the same commands): scan on seed 003, uhl_last2
+// (the paper's baseline without odometry, which has no state to gate an echo against).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "offline_run.hpp"
+#include "sim/faults.hpp"
+#include "sim/scenario_yaml.hpp"
+
+namespace beaconloc {
+namespace {
+
+constexpr int kSeeds = 10;
+constexpr double kMaxMeanRatio = 1.5;  // the issue's limit
+// A seed whose E_p RMS is more than this many times its clean run's lost track for a while.
+constexpr double kLostRatio = 3.0;
+
+struct EchoSetup {
+  const char* estimator;
+  const char* scenario;
+  double echo_probability;
+};
+
+class Echoes : public ::testing::TestWithParam<EchoSetup> {};
+
+TEST_P(Echoes, CostAtMostHalfAgainTheCleanErrorAndNoSeedLosesTrack) {
+  const EchoSetup& setup = GetParam();
+  sim::Scenario clean = sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/" +
+                                                setup.scenario + ".yaml");
+  sim::apply_fault(clean, "echoes=0");  // seed 002's setup has 5 % echoes of its own
+  sim::Scenario faulty = clean;
+  sim::apply_fault(faulty, "echoes=" + std::to_string(setup.echo_probability));
+  double clean_mean_m = 0.0;
+  double faulty_mean_m = 0.0;
+  double worst_seed_ratio = 0.0;
+  for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    const OfflineRunResult c = run_scenario_offline(clean, seed, setup.estimator, {});
+    const OfflineRunResult f = run_scenario_offline(faulty, seed, setup.estimator, {});
+    ASSERT_GT(c.metrics.samples, 0u) << "seed " << seed << ": the clean run scored no pose";
+    ASSERT_GT(f.metrics.samples, 0u) << "seed " << seed << ": the run with echoes scored no pose";
+    clean_mean_m += c.metrics.position_rms_m / kSeeds;
+    faulty_mean_m += f.metrics.position_rms_m / kSeeds;
+    worst_seed_ratio = std::max(worst_seed_ratio, f.metrics.position_rms_m / c.metrics.position_rms_m);
+  }
+  const double ratio = faulty_mean_m / clean_mean_m;
+  std::printf("%s on %s, %.0f %% echoes: E_p RMS clean %.4f m, with echoes %.4f m, ratio %.3f (limit %.1f); "
+              "worst seed %.2f x its clean run (limit %.1f)\n",
+              setup.estimator, setup.scenario, 100.0 * setup.echo_probability, clean_mean_m, faulty_mean_m,
+              ratio, kMaxMeanRatio, worst_seed_ratio, kLostRatio);
+  EXPECT_LE(ratio, kMaxMeanRatio);
+  EXPECT_LE(worst_seed_ratio, kLostRatio);
+}
+
+std::vector<EchoSetup> setups() {
+  std::vector<EchoSetup> out;
+  for (const double p : {0.05, 0.3}) {
+    for (const char* t : {"seed000_trajectory1", "seed000_trajectory2", "seed000_trajectory3", "seed000_trajectory4"}) {
+      out.push_back({"duhl", t, p});
+      out.push_back({"range_ekf", t, p});
+    }
+    out.push_back({"ukf_lrf", "seed001_classroom", p});
+    out.push_back({"kleeman_iekf", "seed002_kleeman", p});  // 5 %: the paper's own setup
+    out.push_back({"two_receiver_ekf", "seed004_two_receivers", p});
+  }
+  return out;
+}
+
+std::string name_of(const ::testing::TestParamInfo<EchoSetup>& info) {
+  std::string name = std::string(info.param.estimator) + "_" + info.param.scenario + "_" +
+                     std::to_string(static_cast<int>(100.0 * info.param.echo_probability + 0.5)) + "pct";
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return name;
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryPaperSetup, Echoes, ::testing::ValuesIn(setups()), name_of);
+
+}  // namespace
+}  // namespace beaconloc
