@@ -1,5 +1,6 @@
 #include "ros2_convert.hpp"
 
+#include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "beaconloc/core/odometry_timeline.hpp"
 
 #include <cmath>
@@ -115,10 +116,10 @@ std::optional<OdometrySample> from_ros_odometry(const nav_msgs::msg::Odometry& m
   o.wheel_base_m = wheel_base_m;
   // v_R = v + omega B / 2, v_L = v - omega B / 2, and the covariance through the same map
   // (a driver's unset covariance, all zeros, stays zero: the estimator's floor applies).
-  o.wheel_velocity_right_mps = v + omega * wheel_base_m / 2.0;
-  o.wheel_velocity_left_mps = v - omega * wheel_base_m / 2.0;
-  Eigen::Matrix2d j;
-  j << 1.0, wheel_base_m / 2.0, 1.0, -wheel_base_m / 2.0;
+  const Eigen::Vector2d wheels_mps = wheel_speeds_mps(v, omega, wheel_base_m);
+  o.wheel_velocity_right_mps = wheels_mps(0);
+  o.wheel_velocity_left_mps = wheels_mps(1);
+  const Eigen::Matrix2d j = wheel_speeds_per_twist(wheel_base_m);
   o.wheel_velocity_covariance = j * Eigen::Vector2d(var_v, var_omega).asDiagonal() * j.transpose();
   // What the localizer would refuse is refused here, by the same checks and reasons: a huge
   // finite twist is an infinite wheel speed on the bus.

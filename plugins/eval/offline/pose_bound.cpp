@@ -69,7 +69,7 @@ std::vector<PoseBoundSample> pose_bound_trace(const sim::Scenario& s, const std:
       close_last(trace);
       double v = 0.0, w = 0.0;
       s.trajectory.mean_velocity(t_s - dt_s, t_s, v, w);
-      const Eigen::Vector2d wheels(v + w * s.wheel_base_m / 2.0, v - w * s.wheel_base_m / 2.0);
+      const Eigen::Vector2d wheels = wheel_speeds_mps(v, w, s.wheel_base_m);
       const DiffDriveMotion motion(
           s.wheel_base_m, sim::wheel_velocity_covariance(s, wheels(0), wheels(1), s.wheel_base_m, dt_s));
       check(bound.predict(motion, truth_at(t_s - dt_s), wheels, dt_s), "odometry step", e.stamp_ns);

@@ -9,6 +9,7 @@
 
 #include "beaconloc/core/csv_reader.hpp"
 #include "beaconloc/core/limits.hpp"
+#include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "beaconloc/core/speed_of_sound.hpp"
 
 namespace beaconloc {
@@ -102,19 +103,9 @@ void ReplaySource::load_beacons(const std::string& path) {
   }
 }
 
-namespace {
-// (v, omega) as the speeds [right, left] of wheels half_track_m from the middle: v +- omega b.
-Eigen::Vector2d wheel_speeds_mps(double v_mps, double omega_radps, double half_track_m) {
-  return {v_mps + omega_radps * half_track_m, v_mps - omega_radps * half_track_m};
-}
-}  // namespace
-
-Eigen::Matrix2d ReplaySource::odometry_covariance(bool own_wheels, double v_mps, double omega_radps, double dt_s,
-                                                  double half_track_m) const {
-  if (own_wheels) {
-    return (options_.odometry_k_v_m * wheel_speeds_mps(v_mps, omega_radps, half_track_m).cwiseAbs() / dt_s)
-        .asDiagonal();
-  }
+Eigen::Matrix2d ReplaySource::odometry_covariance(bool own_wheels, const Eigen::Vector2d& wheels_mps, double v_mps,
+                                                  double dt_s, double half_track_m) const {
+  if (own_wheels) return (options_.odometry_k_v_m * wheels_mps.cwiseAbs() / dt_s).asDiagonal();
   // Noise on (v, omega), independent, carried exactly by the wheel speeds [v_R, v_L] = A [v, omega]
   // that express them: cov = A diag(sigma_v^2, sigma_omega^2) A^T, A = [[1, b], [1, -b]], b the
   // half track used. The filters map it back (seed 000 eq. 16) to the same (v, omega) noise for
@@ -157,7 +148,7 @@ void ReplaySource::load_odometry(const std::string& path) {
       continue;
     }
     // (v, omega) become wheel speeds v +- omega * B/2: each within the physical limit.
-    const Eigen::Vector2d wheels_mps = wheel_speeds_mps(v, w, half_track);
+    const Eigen::Vector2d wheels_mps = wheel_speeds_mps(v, w, 2.0 * half_track);
     const double right = wheels_mps(0), left = wheels_mps(1);
     if (!(std::abs(right) <= kMaxWheelSpeedMps && std::abs(left) <= kMaxWheelSpeedMps)) {
       std::ostringstream why;
@@ -193,7 +184,7 @@ void ReplaySource::load_odometry(const std::string& path) {
     e.odometry.wheel_base_m = 2.0 * half_track;
     e.odometry.wheel_velocity_right_mps = right;
     e.odometry.wheel_velocity_left_mps = left;
-    e.odometry.wheel_velocity_covariance = odometry_covariance(has_half_track, v, w, dt, half_track);
+    e.odometry.wheel_velocity_covariance = odometry_covariance(has_half_track, wheels_mps, v, dt, half_track);
     events_.push_back(e);
   }
 }

@@ -79,7 +79,7 @@ class ReplaySource final : public Source {
   void load_odometry(const std::string& path);
   // The wheel speeds' covariance reported with a row of (v, omega) held over dt_s, its wheels
   // half_track_m from the middle (ReplayOptions: the noise models).
-  Eigen::Matrix2d odometry_covariance(bool own_wheels, double v_mps, double omega_radps, double dt_s,
+  Eigen::Matrix2d odometry_covariance(bool own_wheels, const Eigen::Vector2d& wheels_mps, double v_mps, double dt_s,
                                       double half_track_m) const;
   void load_ranges(const std::string& path);
   void load_pulses(const std::string& path);

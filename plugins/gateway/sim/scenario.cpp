@@ -4,6 +4,7 @@
 #include <optional>
 #include <utility>
 
+#include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "beaconloc/core/speed_of_sound.hpp"
 
 namespace beaconloc::sim {
@@ -83,8 +84,7 @@ Eigen::Matrix2d wheel_velocity_covariance(const Scenario& scenario, double right
                                           double wheel_base_m, double dt_s) {
   if (scenario.odometry_alpha) {
     const double v = (right_mps + left_mps) / 2.0, w = (right_mps - left_mps) / wheel_base_m;
-    Eigen::Matrix2d to_wheels;
-    to_wheels << 1.0, wheel_base_m / 2.0, 1.0, -wheel_base_m / 2.0;
+    const Eigen::Matrix2d to_wheels = wheel_speeds_per_twist(wheel_base_m);
     return to_wheels * alpha_velocity_variances(*scenario.odometry_alpha, v, w).asDiagonal() * to_wheels.transpose();
   }
   Eigen::Matrix2d c = Eigen::Matrix2d::Zero();

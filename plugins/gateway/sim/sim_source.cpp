@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "beaconloc/core/speed_of_sound.hpp"
 
 namespace beaconloc::sim {
@@ -138,7 +139,6 @@ SourceEvent SimSource::odometry_at(StampNs stamp_ns) {
   const double t1 = ns_to_s(stamp_ns);
   double v = 0.0, w = 0.0;
   scenario_.trajectory.mean_velocity(t1 - dt_s, t1, v, w);
-  const double half_track = scenario_.wheel_base_m / 2.0;
   const double reported_base = scenario_.wheel_base_m * (1.0 + scenario_.wheel_base_error);
   SourceEvent e;
   e.kind = SourceEvent::Kind::kOdometry;
@@ -146,8 +146,9 @@ SourceEvent SimSource::odometry_at(StampNs stamp_ns) {
   e.odometry.stamp_ns = stamp_ns;
   e.odometry.wheel_base_m = reported_base;
   // Systematic errors (wheel radii) scale what the encoders report.
-  double right = (v + w * half_track) * (1.0 + scenario_.wheel_radius_error_right);
-  double left = (v - w * half_track) * (1.0 + scenario_.wheel_radius_error_left);
+  const Eigen::Vector2d wheels_mps = wheel_speeds_mps(v, w, scenario_.wheel_base_m);
+  double right = wheels_mps(0) * (1.0 + scenario_.wheel_radius_error_right);
+  double left = wheels_mps(1) * (1.0 + scenario_.wheel_radius_error_left);
   if (scenario_.odometry_alpha) {
     // Seed 001 eq. 6: noise on the velocities the robot reports, (v, w) from its wheels.
     const auto variances = [this](double lin, double ang) {

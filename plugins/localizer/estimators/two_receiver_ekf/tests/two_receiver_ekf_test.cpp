@@ -104,6 +104,27 @@ TEST(TwoReceiverEkf, AnEchoLongerThanTheOtherReceiversRangeAllowsIsRefused) {
   EXPECT_NE(e->update(later[1]).rejection, Rejection::kEchoOfFiring);
 }
 
+// Until a receiver's gate closes, a range much longer than predicted is fused down-weighted
+// (open_gate_echo_sigma); such ranges do not count as agreeing, so a run of them cannot close the
+// gate (the next would then be refused as gated rather than down-weighted).
+TEST(TwoReceiverEkf, RangesDownWeightedAsEchoesDoNotCloseTheGate) {
+  const Pose2 truth(1.0, 1.2, 0.8);
+  EstimatorConfig config = two_receivers();
+  config.initial_pose = truth;
+  config.parameters = {{"initial_sigma_m", 0.05}};
+  auto e = EstimatorRegistry::instance().create("two_receiver_ekf", config);
+  e->set_beacon_map(kMap);
+  StampNs t = 0;
+  for (int k = 0; k < 15; ++k) {  // more than gate_after_agreeing (10)
+    t += 50 * kNsPerMillisecond;
+    ASSERT_TRUE(e->predict(standing_odometry(t, 0.3, 1e-6)).accepted);
+    RangeMeasurement front = test_support::exact_ranges(truth, config.receivers, *kMap.find(1 + k % 4), t)[0];
+    front.range_m += 0.5;  // ten sigma of the innovation and more: down-weighted, not agreeing
+    const InputResult u = e->update(front);
+    EXPECT_TRUE(u.accepted) << "range " << k << ": " << (u.rejection ? to_string(*u.rejection) : "");
+  }
+}
+
 // Ranges that put the front receiver 0.4 m from where the rear one and the mounting put it (a
 // receiver's filter pulled onto a wrong solution): the pair contradicts the rigid robot, and the
 // pose is degraded, not ok.

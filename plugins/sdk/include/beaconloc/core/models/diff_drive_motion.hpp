@@ -21,6 +21,20 @@ struct DiffDrivePrediction {
 // prints the second factor with "R").
 DiffDrivePrediction predict_diff_drive(const Pose2& pose, double wheel_velocity_right_mps,
                                        double wheel_velocity_left_mps, double wheel_base_m, double dt_s);
+// Eq. 14 read backwards: the speeds [v_R, v_L] of wheels wheel_base_m apart on a robot moving at
+// v and turning at omega, v +- omega B_w / 2 ...
+inline Eigen::Vector2d wheel_speeds_mps(double v_mps, double omega_radps, double wheel_base_m) {
+  const double half_track_m = wheel_base_m / 2.0;
+  return {v_mps + omega_radps * half_track_m, v_mps - omega_radps * half_track_m};
+}
+// ... and that map's matrix, d[v_R, v_L] / d[v, omega] = [[1, B_w / 2], [1, -B_w / 2]], which
+// carries a covariance of (v, omega) to the wheels.
+inline Eigen::Matrix2d wheel_speeds_per_twist(double wheel_base_m) {
+  Eigen::Matrix2d j;
+  j << 1.0, wheel_base_m / 2.0, 1.0, -wheel_base_m / 2.0;
+  return j;
+}
+
 // The same without the moved pose (pose is left as given): the step and the Jacobians, all a
 // filter composing x (+) dx needs (it wraps the heading itself: one wrap, not two).
 DiffDrivePrediction diff_drive_step(const Pose2& pose, double wheel_velocity_right_mps, double wheel_velocity_left_mps,
