@@ -62,6 +62,22 @@ TEST(Ekf, GatesOutliersAndLeavesTheStateAlone) {
   EXPECT_EQ(ekf.state(), Eigen::Vector3d::Zero());
 }
 
+// What update() would judge, without the update: the innovation and H P H^T (its NIS against
+// them is update()'s); an unusable measurement gives none.
+TEST(Ekf, PriorInnovationIsWhatTheUpdateSeesAndChangesNothing) {
+  Ekf<3> ekf;
+  ekf.reset(Eigen::Vector3d(0.2, 0.0, 0.0), 0.01 * Eigen::Matrix3d::Identity());
+  const LinearModel<1, 3> model(Eigen::Matrix<double, 1, 3>(1.0, 0.5, 0.0), Mat<1, 1>(0.04));
+  const auto prior = ekf.prior_innovation(model, Vec<1>(1.0));
+  ASSERT_TRUE(prior);
+  EXPECT_NEAR(prior->innovation(0), 0.8, 1e-12);
+  EXPECT_NEAR(prior->state_covariance(0, 0), 0.01 * 1.25, 1e-12);
+  EXPECT_EQ(ekf.state(), Eigen::Vector3d(0.2, 0.0, 0.0));
+  const auto result = ekf.update(model, Vec<1>(1.0), 1e9);
+  EXPECT_NEAR(result.nis, 0.8 * 0.8 / (0.0125 + 0.04), 1e-9);
+  EXPECT_FALSE(ekf.prior_innovation(model, Vec<1>(std::nan(""))));
+}
+
 TEST(Ekf, RefusesASingularInnovationCovariance) {
   Ekf<3> ekf;
   ekf.reset(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero());

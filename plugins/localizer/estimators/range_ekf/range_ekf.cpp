@@ -149,11 +149,11 @@ InputResult RangeEkf::fuse(const RangeMeasurement& r, const Pose2& odom_pose_at_
     // The range's noise as learnt so far (RangeNoiseScale), then this innovation learnt from,
     // unless the ranges make the pose suspect: a filter that is off would teach a sigma too large.
     variance_m2 = noise_scale_.variance_m2(r.variance_m2);
-    if (!suspect_) with_filter([&](const auto& filter) {
-      const auto lin = model.linearize(filter.state());
-      noise_scale_.learn(r.range_m - lin.predicted(0), (lin.jacobian * filter.covariance() * lin.jacobian.transpose())(0, 0),
-                         r.variance_m2);
-    });
+    if (!suspect_) {
+      const auto prior = with_filter(
+          [&](const auto& filter) { return filter.prior_innovation(model, RangeModel::Vector(r.range_m)); });
+      if (prior) noise_scale_.learn(prior->innovation(0), prior->state_covariance(0, 0), r.variance_m2);
+    }
   }
   const UpdateResult result = with_filter([&](auto& filter) {
     return filter.update(model_with(variance_m2), RangeModel::Vector(r.range_m), params_.nis_gate);

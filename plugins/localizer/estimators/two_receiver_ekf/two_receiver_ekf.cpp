@@ -125,9 +125,9 @@ InputResult TwoReceiverEkf::update(const RangeMeasurement& r) {
   std::optional<double> declared_nis;  // of a range fused down-weighted: its NIS as declared
   if (!gate.closed && params_.open_gate_echo_sigma > 0.0) {  // TwoReceiverEkfParameters::open_gate_echo_sigma
     const PointRangeModel as_declared(receiver_z_m_, map().find(r.beacon_id)->position_map_m, r.variance_m2);
-    const auto lin = as_declared.linearize(filter.state());
-    const double innovation_m = r.range_m - lin.predicted(0);
-    const double s_m2 = (lin.jacobian * filter.covariance() * lin.jacobian.transpose())(0, 0) + r.variance_m2;
+    const auto prior = filter.prior_innovation(as_declared, PointRangeModel::Vector(r.range_m));
+    const double innovation_m = prior ? prior->innovation(0) : 0.0;  // unusable: update() refuses it
+    const double s_m2 = prior ? prior->state_covariance(0, 0) + r.variance_m2 : r.variance_m2;
     const double limit_m = params_.open_gate_echo_sigma * std::sqrt(s_m2);
     if (innovation_m > limit_m) {
       variance_m2 += (innovation_m * innovation_m / (limit_m * limit_m) - 1.0) * s_m2;

@@ -25,6 +25,13 @@ EstimatorConfig two_receivers() {
 // Four ceiling generators 4.4 m above the receivers, around the robot.
 const BeaconMap kMap({{1, {0.0, 0.0, 5.4}, 0}, {2, {2.0, 0.0, 5.4}, 0}, {3, {0.0, 2.0, 5.4}, 0}, {4, {2.0, 2.0, 5.4}, 0}});
 
+// The estimator of this config, given kMap.
+std::unique_ptr<Estimator> on_the_map(const EstimatorConfig& config) {
+  auto e = EstimatorRegistry::instance().create("two_receiver_ekf", config);
+  e->set_beacon_map(kMap);
+  return e;
+}
+
 TEST(TwoReceiverEkf, TakesTwoReceiversApartAndWaitsForItsInitialPose) {
   EstimatorConfig one = two_receivers();
   one.receivers.receivers_base_m.resize(1);
@@ -52,8 +59,7 @@ TEST(TwoReceiverEkf, ConvergesFromThePapersStartOnExactRanges) {
   const Pose2 truth(1.0, 1.2, 0.8);
   EstimatorConfig config = two_receivers();
   config.initial_pose = Pose2(0.5, 0.7, 0.5);
-  auto e = EstimatorRegistry::instance().create("two_receiver_ekf", config);
-  e->set_beacon_map(kMap);
+  auto e = on_the_map(config);
   StampNs t = 0;
   for (int cycle = 0; cycle < 40; ++cycle) {
     for (const Beacon& b : kMap.beacons()) {
@@ -79,8 +85,7 @@ TEST(TwoReceiverEkf, AnEchoLongerThanTheOtherReceiversRangeAllowsIsRefused) {
   const Pose2 truth(1.0, 1.2, 0.8);
   EstimatorConfig config = two_receivers();
   config.initial_pose = truth;
-  auto e = EstimatorRegistry::instance().create("two_receiver_ekf", config);
-  e->set_beacon_map(kMap);
+  auto e = on_the_map(config);
   StampNs t = 50 * kNsPerMillisecond;
   ASSERT_TRUE(e->predict(standing_odometry(t, 0.3, 1e-6)).accepted);
   const auto firing = [&](std::uint32_t id, StampNs stamp) {
@@ -112,8 +117,7 @@ TEST(TwoReceiverEkf, RangesDownWeightedAsEchoesDoNotCloseTheGate) {
   EstimatorConfig config = two_receivers();
   config.initial_pose = truth;
   config.parameters = {{"initial_sigma_m", 0.05}};
-  auto e = EstimatorRegistry::instance().create("two_receiver_ekf", config);
-  e->set_beacon_map(kMap);
+  auto e = on_the_map(config);
   StampNs t = 0;
   for (int k = 0; k < 15; ++k) {  // more than gate_after_agreeing (10)
     t += 50 * kNsPerMillisecond;
@@ -132,8 +136,7 @@ TEST(TwoReceiverEkf, ReceiversThatContradictTheMountingMakeThePoseDegraded) {
   const Pose2 truth(1.0, 1.2, 0.0);
   EstimatorConfig config = two_receivers();
   config.initial_pose = truth;
-  auto e = EstimatorRegistry::instance().create("two_receiver_ekf", config);
-  e->set_beacon_map(kMap);
+  auto e = on_the_map(config);
   ReceiverArray stretched = config.receivers;
   stretched.receivers_base_m[0] = {kL + 0.4, 0.0};
   StampNs t = 0;

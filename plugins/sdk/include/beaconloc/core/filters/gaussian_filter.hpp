@@ -104,6 +104,13 @@ class GaussianFilter {
 };
 
 // The prediction of the filters that linearize (EKF, iterated EKF, H-infinity).
+// LinearizedFilter::prior_innovation.
+template <int M>
+struct PriorInnovation {
+  Vec<M> innovation;
+  Mat<M, M> state_covariance;  // H P H^T
+};
+
 template <int N>
 class LinearizedFilter : public GaussianFilter<N> {
  public:
@@ -111,6 +118,21 @@ class LinearizedFilter : public GaussianFilter<N> {
   using typename GaussianFilter<N>::State;
   using typename GaussianFilter<N>::Covariance;
   explicit LinearizedFilter(Space space = Space()) : GaussianFilter<N>(space) {}
+
+  // Without updating: the innovation z (-) h(x) at the current state and the share H P H^T of its
+  // covariance the state puts there (S less the model's R), for an estimator that decides from
+  // them how to fuse z (its weight, its gate). nullopt when z, R, h or H is not usable (update()
+  // would refuse it).
+  template <class Model>
+  std::optional<PriorInnovation<Model::kSize>> prior_innovation(const Model& model,
+                                                                const typename Model::Vector& z) const {
+    if (this->check_measurement(model, z, model.noise()) != FilterOutcome::kApplied) return std::nullopt;
+    PriorInnovation<Model::kSize> out;
+    Mat<Model::kSize, N> h;
+    if (linearize_at(model, z, this->x_, out.innovation, h) != FilterOutcome::kApplied) return std::nullopt;
+    out.state_covariance = h * this->p_ * h.transpose();
+    return out;
+  }
 
   // x = x (+) dx, P = F P F^T + G U G^T (+ Q). Not applied (kNonFinite, nothing changed) when
   // the model's step, Jacobians or noise are not finite: checked on the result, which any
