@@ -22,6 +22,7 @@ struct UpdateResult {
   double nis = 0.0;    // normalized innovation squared nu^T S^-1 nu (at the prior)
   double log_det_s = 0.0;  // log det S (at the prior): with nis, the innovation's likelihood
   int iterations = 0;  // linearizations made (1 for the EKF, up to the cap for the IEKF)
+  int components_gated = 0;  // UKF ComponentGate: components left out one by one as outliers
   bool applied() const { return outcome == FilterOutcome::kApplied; }
 };
 
