@@ -5,6 +5,7 @@
 // (seed001_classroom_unknown.yaml): the paper's filter without a beam gate against ours.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -35,6 +36,16 @@ ModeResult mean_over_ten_seeds(const sim::Scenario& scenario, const std::string&
   return r;
 }
 
+sim::Scenario classroom(const std::string& name) {
+  return sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/scenarios/" + name + ".yaml");
+}
+
+// Table 6's cases 3, 5 and 4: fusion, laser only, beacons only.
+std::array<ModeResult, 3> three_modes(const sim::Scenario& scenario) {
+  return {mean_over_ten_seeds(scenario, "ukf_lrf"), mean_over_ten_seeds(scenario, "ukf_lrf_laser_only"),
+          mean_over_ten_seeds(scenario, "ukf_lrf_beacons_only")};
+}
+
 // Table 6's order is fusion < laser only < beacons only. In simulation the laser sees exactly its
 // map, and its 19 beams at 45 Hz carry about 2000 times the information of the four beacon
 // ranges per 625 ms: fusion and laser only tie (docs/accuracy-seed001.md, the physics). What is
@@ -42,11 +53,8 @@ ModeResult mean_over_ten_seeds(const sim::Scenario& scenario, const std::string&
 // the beacons alone and are within Table 6, and the anonymous ranges are associated far above
 // chance.
 TEST(UkfLrfOnSeed001, LaserModesWithinTableSixFusionNoWorseThanLaserOnlyBothBeatBeaconsOnly) {
-  const sim::Scenario scenario = sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) +
-                                                         "/examples/scenarios/seed001_classroom.yaml");
-  const ModeResult fusion = mean_over_ten_seeds(scenario, "ukf_lrf");
-  const ModeResult laser = mean_over_ten_seeds(scenario, "ukf_lrf_laser_only");
-  const ModeResult beacons = mean_over_ten_seeds(scenario, "ukf_lrf_beacons_only");
+  const sim::Scenario scenario = classroom("seed001_classroom");
+  const auto [fusion, laser, beacons] = three_modes(scenario);
   std::printf(
       "RMSE: fusion %.4f m, laser only %.4f m, beacons only %.4f m; association: fusion %.1f %%, "
       "beacons only %.1f %%\n",
@@ -67,11 +75,8 @@ TEST(UkfLrfOnSeed001, LaserModesWithinTableSixFusionNoWorseThanLaserOnlyBothBeat
 // 10 cm map, chairs and things the map lacks, five people walking, the LMS-511's own errors and
 // mixed pixels (docs/accuracy-seed001.md, "The classroom the map does not fully know").
 TEST(UkfLrfOnSeed001, InARoomTheMapDoesNotFullyKnowTheBeamGateKeepsTrackWhereThePapersFilterLosesIt) {
-  const sim::Scenario scenario = sim::load_scenario_file(std::string(BEACONLOC_SOURCE_DIR) +
-                                                         "/examples/scenarios/seed001_classroom_unknown.yaml");
-  const ModeResult fusion = mean_over_ten_seeds(scenario, "ukf_lrf");
-  const ModeResult laser = mean_over_ten_seeds(scenario, "ukf_lrf_laser_only");
-  const ModeResult beacons = mean_over_ten_seeds(scenario, "ukf_lrf_beacons_only");
+  const sim::Scenario scenario = classroom("seed001_classroom_unknown");
+  const auto [fusion, laser, beacons] = three_modes(scenario);
   // The paper's eq. 16-21 fuse every beam: a gate of 100 sigma refuses none.
   const ModeResult ungated = mean_over_ten_seeds(scenario, "ukf_lrf", {"beam_gate_sigma=100"});
   std::printf(
