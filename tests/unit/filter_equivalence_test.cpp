@@ -383,9 +383,22 @@ TEST(FilterEquivalence, TheUkfComponentGateFusesTheOthersAsIfTheOutlierWereNotMe
   ASSERT_TRUE(points);
   result = ukf.update(*points, model, Vec<3>(z + Vec<3>::Constant(100.0)), std::numeric_limits<double>::infinity(),
                       ComponentGate{0, 3, 3.0});
-  EXPECT_EQ(result.outcome, FilterOutcome::kGated);
+  EXPECT_EQ(result.outcome, FilterOutcome::kEveryComponentGated);
+  EXPECT_EQ(result.components_gated, 3);
   EXPECT_EQ(ukf.state(), x0);
   EXPECT_EQ(ukf.covariance(), prior_covariance());
+  // A gate that is no number, or reaches past the measurement, is taken as it can be: NaN gates
+  // nothing, the range is clamped to the components there are.
+  for (const ComponentGate odd : {ComponentGate{0, 3, std::nan("")}, ComponentGate{0, 3, -1.0},
+                                  ComponentGate{2, std::numeric_limits<Eigen::Index>::max(), 3.0},
+                                  ComponentGate{std::numeric_limits<Eigen::Index>::max(), 5, 3.0}}) {
+    ukf.reset(x0, prior_covariance());
+    points = ukf.sigma_points(r);
+    ASSERT_TRUE(points);
+    result = ukf.update(*points, model, z, std::numeric_limits<double>::infinity(), odd);
+    ASSERT_TRUE(result.applied());
+    EXPECT_EQ(result.components_gated, odd.sigmas == 3.0 && odd.first == 2 ? 1 : 0);
+  }
 }
 
 }  // namespace

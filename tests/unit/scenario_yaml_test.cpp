@@ -112,13 +112,18 @@ laser: {range_sigma_m: 0.006, systematic_error_m: 0.025, spot_diameter_at_window
   EXPECT_TRUE(s.world->occupied_at({2.51, 1.01}));
   EXPECT_FALSE(s.map->occupied_at({2.51, 1.01}));
   ASSERT_EQ(s.people.size(), 1u);
-  EXPECT_TRUE(s.people[0].position_at(2.5).isApprox(Eigen::Vector2d(2.5, 0.5)));
+  EXPECT_TRUE(s.people[0].at(2.5).centre_m.isApprox(Eigen::Vector2d(2.5, 0.5)));
   EXPECT_DOUBLE_EQ(s.laser->systematic_error_m, 0.025);
   EXPECT_DOUBLE_EQ(s.laser->spot.divergence_rad, 0.011);
   EXPECT_DOUBLE_EQ(s.laser->spot.echo_merge_m, 0.5);
   EXPECT_NE(error_of(std::string(kMinimal) + "people:\n  - {path_m: [[0, 0]]}\n")
-                .find("'people[0].path_m' must list at least two points"),
+                .find("'people[0].path_m' must list 2 to 1000 points"),
             std::string::npos);
+  EXPECT_NE(error_of(std::string(kMinimal) + "people:\n  - {path_m: [[1, 1], [1, 1]]}\n").find("finite length"),
+            std::string::npos);
+  std::string crowd = std::string(kMinimal) + "people:\n";
+  for (int i = 0; i < 101; ++i) crowd += "  - {path_m: [[0, 0], [1, 1]]}\n";
+  EXPECT_NE(error_of(crowd).find("'people' may list at most 100 walkers"), std::string::npos);
   EXPECT_NE(error_of(std::string(kMinimal) + "map: {size_m: [4, 3], world_resolution_m: 0.5}\n")
                 .find("'map.world_resolution_m' must be in"),
             std::string::npos);

@@ -407,24 +407,34 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
   }
 }
 
-// People walking (Walker): each a path of at least two points, a speed and a radius.
+// People walking (Walker): each a path of at least two points, a speed and a radius. At most
+// kMaxPeople of kMaxPathPoints each: every scan casts its rays against every one.
+constexpr std::size_t kMaxPeople = 100;
+constexpr std::size_t kMaxPathPoints = 1000;
+
 void read_people(const Section& root, Scenario& sc) {
   if (!root.has("people")) return;
   const YAML::Node list = root.node("people");
   if (!list.IsSequence()) root.fail("people", "must list walkers", list);
+  if (list.size() > kMaxPeople) root.fail("people", "may list at most " + std::to_string(kMaxPeople) + " walkers", list);
   for (std::size_t i = 0; i < list.size(); ++i) {
     const Section w(list[i], "people[" + std::to_string(i) + "]", root.origin(),
                     {"path_m", "speed_mps", "radius_m"});
-    Walker walker;
     const YAML::Node path = w.node("path_m");
-    for (std::size_t k = 0; path && path.IsSequence() && k < path.size(); ++k) {
-      walker.path_m.push_back(
-          vec2(w, path[k], w.join("path_m") + "[" + std::to_string(k) + "]", kMaxMapCoordinateM));
+    if (!path || !path.IsSequence() || path.size() < 2 || path.size() > kMaxPathPoints) {
+      w.fail(w.join("path_m"), "must list 2 to " + std::to_string(kMaxPathPoints) + " points", list[i]);
     }
-    if (walker.path_m.size() < 2) w.fail(w.join("path_m"), "must list at least two points", list[i]);
-    walker.speed_mps = w.number("speed_mps", 1.0, 1e-3, 10.0);
-    walker.radius_m = w.number("radius_m", 0.2, 0.01, 5.0);
-    sc.people.push_back(std::move(walker));
+    std::vector<Eigen::Vector2d> points;
+    for (std::size_t k = 0; k < path.size(); ++k) {
+      points.push_back(vec2(w, path[k], w.join("path_m") + "[" + std::to_string(k) + "]", kMaxMapCoordinateM));
+    }
+    const double speed = w.number("speed_mps", 1.0, 1e-3, 10.0);
+    const double radius = w.number("radius_m", 0.2, 0.01, 5.0);
+    try {
+      sc.people.emplace_back(std::move(points), speed, radius);
+    } catch (const std::invalid_argument& e) {
+      w.fail(w.join("path_m"), e.what(), list[i]);
+    }
   }
 }
 

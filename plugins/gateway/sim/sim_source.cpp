@@ -201,10 +201,10 @@ SourceEvent SimSource::scan_at(StampNs stamp_ns) {
   e.scan.range_min_m = 0.0f;
   e.scan.range_max_m = static_cast<float>(laser.max_range_m);
   const OccupancyGrid& world = scenario_.world ? *scenario_.world : *scenario_.map;
+  const std::vector<Disc> people = discs_at(scenario_.people, ns_to_s(stamp_ns));
   for (int i = 0; i < laser.beams; ++i) {
     const double angle = sensor.z() - laser.fov_rad / 2.0 + i * increment;
-    const auto hit =
-        spot_reading_m(world, scenario_.people, ns_to_s(stamp_ns), laser.spot, sensor.head<2>(), angle, laser.max_range_m);
+    const auto hit = spot_reading_m(world, people, laser.spot, sensor.head<2>(), angle, laser.max_range_m);
     const double noise = normal();  // drawn for every beam: the stream does not depend on hits
     const double systematic_m = beam_errors_m_.empty() ? 0.0 : beam_errors_m_[static_cast<std::size_t>(i)];
     e.scan.ranges_m.push_back(

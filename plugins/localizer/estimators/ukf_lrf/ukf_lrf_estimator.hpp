@@ -40,7 +40,8 @@ struct UkfLrfParameters {
   // of its own predicted standard deviations from the ray cast (|z_i - z_i_mean| > g sqrt(S_ii),
   // eq. 18-19) is left out of the update (ComponentGate), counted in `beams_gated`. In a room
   // the map does not fully know (people, furniture moved in), such beams met something the map
-  // lacks; fused, a few of them pull the pose off the corridor.
+  // lacks; fused, a few of them pull the pose off the corridor. 0: no gate, every beam fused as
+  // the paper does.
   double beam_gate_sigma = 3.0;
 
   // estimator: the mode's registered name, for the messages.

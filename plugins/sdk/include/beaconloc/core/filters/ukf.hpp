@@ -39,7 +39,8 @@ struct UkfOptions {
 // times their own predicted standard deviation (|nu_i| > sigmas sqrt(S_ii)) are left out of the
 // update one by one: the others are fused as if those had not been measured (their rows and
 // columns of S and P_xz dropped, which is exact). For a vector of independent readings of which
-// a few may be gross outliers (laser beams that met what the map does not have). No gate: none.
+// a few may be gross outliers (laser beams that met what the map does not have). The default,
+// or a gate that is not a positive number, leaves every component in.
 struct ComponentGate {
   Eigen::Index first = 0;
   Eigen::Index count = 0;
@@ -157,7 +158,7 @@ class Ukf : public GaussianFilter<N> {
 
   template <class Model>
   UpdateResult update(const Model& model, const typename Model::Vector& z,
-                      double nis_gate = std::numeric_limits<double>::infinity()) {
+                      double nis_gate = std::numeric_limits<double>::infinity(), ComponentGate gate = {}) {
     const Eigen::MatrixXd r = model.noise();
     UpdateResult result;
     result.iterations = 1;
@@ -168,7 +169,7 @@ class Ukf : public GaussianFilter<N> {
       result.outcome = FilterOutcome::kNotPositiveDefinite;
       return result;
     }
-    return correct(*points, model, z, r, nis_gate);
+    return correct(*points, model, z, r, nis_gate, gate);
   }
 
   // Seed 001 eq. 15-22 over points drawn for this belief: z_i = h(x_i) (+ v_i, eq. 16), their
@@ -194,7 +195,7 @@ class Ukf : public GaussianFilter<N> {
   // this belief's, drawn for r.
   template <class Model>
   UpdateResult correct(const SigmaPoints<N>& points, const Model& model, const typename Model::Vector& z,
-                       const Eigen::MatrixXd& r, double nis_gate, ComponentGate gate = {}) {
+                       const Eigen::MatrixXd& r, double nis_gate, ComponentGate gate) {
     UpdateResult result;
     result.iterations = 1;
     const Eigen::Index m = model.size();
@@ -239,7 +240,7 @@ class Ukf : public GaussianFilter<N> {
     Eigen::MatrixXd xz = weighted_cross_covariance(points.deviations_, z_centred, w);  // eq. 20
     Eigen::VectorXd innovation = model.residual(z, z_mean);
     if (!leave_out_gated(gate, innovation, s, xz, result.components_gated)) {
-      result.outcome = FilterOutcome::kGated;
+      result.outcome = FilterOutcome::kEveryComponentGated;
       return result;
     }
     const InnovationFactor<Eigen::Dynamic> factor(s);
@@ -269,9 +270,10 @@ class Ukf : public GaussianFilter<N> {
   // columns of P_xz, counting them; false when nothing is left to fuse.
   static bool leave_out_gated(const ComponentGate& gate, Eigen::VectorXd& innovation, Eigen::MatrixXd& s,
                               Eigen::MatrixXd& xz, int& gated) {
+    if (!(gate.sigmas > 0.0)) return true;  // no gate (and a NaN one gates nothing)
     const Eigen::Index m = innovation.size();
-    const Eigen::Index first = std::max<Eigen::Index>(0, gate.first);
-    const Eigen::Index last = std::min<Eigen::Index>(m, first + std::max<Eigen::Index>(0, gate.count));
+    const Eigen::Index first = std::clamp<Eigen::Index>(gate.first, 0, m);
+    const Eigen::Index last = first + std::clamp<Eigen::Index>(gate.count, 0, m - first);
     std::vector<Eigen::Index> kept;
     kept.reserve(static_cast<std::size_t>(m));
     for (Eigen::Index i = 0; i < m; ++i) {
