@@ -70,6 +70,7 @@ std::vector<EchoSetup> setups() {
       out.push_back({"range_ekf", t, p});
     }
     out.push_back({"ukf_lrf", "seed001_classroom", p});
+    out.push_back({"ukf_lrf", "seed001_classroom_unknown", p});  // the classroom as the paper ran it
     out.push_back({"kleeman_iekf", "seed002_kleeman", p});  // 5 %: the paper's own setup
     out.push_back({"two_receiver_ekf", "seed004_two_receivers", p});
   }

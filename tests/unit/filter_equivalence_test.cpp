@@ -6,7 +6,9 @@
 //  - the H-infinity filter tends to the EKF as its bound is relaxed (theta -> 0);
 //  - the IEKF on a static range-only problem converges to the Gauss-Newton solution
 //    (core/solvers/range_pose_solver);
-//  - every failure is an outcome that leaves the state and covariance as they were.
+//  - every failure is an outcome that leaves the state and covariance as they were;
+//  - the UKF's component gate fuses the other components exactly as if the gated one had not
+//    been measured.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -329,6 +331,74 @@ TEST(FilterEquivalence, ASingularInnovationIsRefused) {
   ukf.reset(Vec<3>::Zero(), Mat<3, 3>::Zero());
   EXPECT_EQ(ukf.update(LinearModel<1, 3>(Mat<1, 3>(1.0, 0.0, 0.0), Mat<1, 1>(0.01)), Vec<1>(0.1)).outcome,
             FilterOutcome::kNotPositiveDefinite);
+}
+
+// The textbook Kalman correction of x, P with the rows `rows` of z = H x + v.
+std::pair<Vec<3>, Mat<3, 3>> kalman_with_rows(const Vec<3>& x, const Mat<3, 3>& p, const Mat<3, 3>& h,
+                                              const Mat<3, 3>& r, const Vec<3>& z, const std::vector<Eigen::Index>& rows) {
+  const Eigen::MatrixXd hs = h(rows, Eigen::all), rs = r(rows, rows);
+  const Eigen::VectorXd zs = z(rows);
+  const Eigen::MatrixXd s = hs * p * hs.transpose() + rs;
+  const Eigen::MatrixXd k = p * hs.transpose() * s.inverse();
+  return {x + k * (zs - hs * x), p - k * s * k.transpose()};
+}
+
+TEST(FilterEquivalence, TheUkfComponentGateFusesTheOthersAsIfTheOutlierWereNotMeasured) {
+  Mat<3, 3> h;
+  h << 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0;
+  const Mat<3, 3> r = Vec<3>(0.01, 0.02, 0.015).asDiagonal();
+  const Vec<3> x0(1.0, 2.0, 0.3);
+  const LinearModel<3, 3> model(h, r);
+  // Rows 0 and 1 agree with the prior; row 2 reads 40 of its sigmas long (a beam short of an
+  // unmapped obstacle, reversed).
+  Vec<3> z = h * x0 + Vec<3>(0.05, -0.04, 0.0);
+  z(2) += 40.0 * std::sqrt((h.row(2) * prior_covariance() * h.row(2).transpose())(0, 0) + r(2, 2));
+  for (const bool augmented : {false, true}) {
+    SCOPED_TRACE(augmented ? "noise augmented" : "noise additive");
+    Ukf<3> ukf(StateSpace<3>(), UkfOptions{{}, augmented});
+    ukf.reset(x0, prior_covariance());
+    const std::optional<SigmaPoints<3>> points = ukf.sigma_points(r);
+    ASSERT_TRUE(points);
+    const UpdateResult result = ukf.update(*points, model, z, std::numeric_limits<double>::infinity(),
+                                           ComponentGate{0, 3, 3.0});
+    ASSERT_TRUE(result.applied());
+    EXPECT_EQ(result.components_gated, 1);
+    const auto [x, p] = kalman_with_rows(x0, prior_covariance(), h, r, z, {0, 1});
+    EXPECT_TRUE(ukf.state().isApprox(x, 1e-9)) << ukf.state().transpose() << " vs " << x.transpose();
+    EXPECT_TRUE(ukf.covariance().isApprox(p, 1e-9));
+  }
+  // A gate over rows 0-1 only leaves row 2 to the update: the full Kalman correction.
+  Ukf<3> ukf{StateSpace<3>()};
+  ukf.reset(x0, prior_covariance());
+  std::optional<SigmaPoints<3>> points = ukf.sigma_points(r);
+  ASSERT_TRUE(points);
+  UpdateResult result =
+      ukf.update(*points, model, z, std::numeric_limits<double>::infinity(), ComponentGate{0, 2, 3.0});
+  ASSERT_TRUE(result.applied());
+  EXPECT_EQ(result.components_gated, 0);
+  EXPECT_TRUE(ukf.state().isApprox(kalman_with_rows(x0, prior_covariance(), h, r, z, {0, 1, 2}).first, 1e-9));
+  // Every component gated: nothing to fuse, refused, nothing changed.
+  ukf.reset(x0, prior_covariance());
+  points = ukf.sigma_points(r);
+  ASSERT_TRUE(points);
+  result = ukf.update(*points, model, Vec<3>(z + Vec<3>::Constant(100.0)), std::numeric_limits<double>::infinity(),
+                      ComponentGate{0, 3, 3.0});
+  EXPECT_EQ(result.outcome, FilterOutcome::kEveryComponentGated);
+  EXPECT_EQ(result.components_gated, 3);
+  EXPECT_EQ(ukf.state(), x0);
+  EXPECT_EQ(ukf.covariance(), prior_covariance());
+  // A gate that is no number, or reaches past the measurement, is taken as it can be: NaN gates
+  // nothing, the range is clamped to the components there are.
+  for (const ComponentGate odd : {ComponentGate{0, 3, std::nan("")}, ComponentGate{0, 3, -1.0},
+                                  ComponentGate{2, std::numeric_limits<Eigen::Index>::max(), 3.0},
+                                  ComponentGate{std::numeric_limits<Eigen::Index>::max(), 5, 3.0}}) {
+    ukf.reset(x0, prior_covariance());
+    points = ukf.sigma_points(r);
+    ASSERT_TRUE(points);
+    result = ukf.update(*points, model, z, std::numeric_limits<double>::infinity(), odd);
+    ASSERT_TRUE(result.applied());
+    EXPECT_EQ(result.components_gated, odd.sigmas == 3.0 && odd.first == 2 ? 1 : 0);
+  }
 }
 
 }  // namespace

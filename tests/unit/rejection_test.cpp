@@ -30,7 +30,7 @@ TEST(Rejection, EveryReasonHasItsOwnSnakeCaseName) {
 TEST(Rejection, EveryFilterOutcomeHasItsReason) {
   for (FilterOutcome o : {FilterOutcome::kGated, FilterOutcome::kSingularInnovation, FilterOutcome::kNotPositiveDefinite,
                           FilterOutcome::kBoundNotMet, FilterOutcome::kNonFinite, FilterOutcome::kSizeMismatch,
-                          FilterOutcome::kStaleSigmaPoints}) {
+                          FilterOutcome::kStaleSigmaPoints, FilterOutcome::kEveryComponentGated}) {
     EXPECT_STREQ(to_string(o), to_string(*rejection_for(o)));
   }
   EXPECT_EQ(rejection_for(FilterOutcome::kGated), Rejection::kGatedNis);

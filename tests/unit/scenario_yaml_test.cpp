@@ -88,6 +88,47 @@ TEST(ScenarioYaml, UnmappedObstaclesAreInTheWorldTheLaserSeesNotInTheMap) {
   EXPECT_FALSE(parse_scenario(kMinimal + std::string("map:\n  size_m: [4.0, 3.0]\n")).world);
 }
 
+TEST(ScenarioYaml, TheRoomAsBuiltIsOnAFinerGridThanTheMapWithPeopleAndTheScannersErrors) {
+  const Scenario s = parse_scenario(std::string(kMinimal) + R"(map:
+  resolution_m: 0.1
+  world_resolution_m: 0.02
+  size_m: [4.0, 3.0]
+  border: false
+  obstacles:
+    - {min_m: [1.03, 1.0], max_m: [1.5, 1.5]}
+  unmapped_obstacles:
+    - {min_m: [2.5, 1.0], max_m: [2.53, 1.03]}
+people:
+  - {path_m: [[0.5, 0.5], [3.5, 0.5]], speed_mps: 0.8, radius_m: 0.25}
+laser: {range_sigma_m: 0.006, systematic_error_m: 0.025, spot_diameter_at_window_m: 0.013,
+        spot_divergence_rad: 0.011, echo_merge_m: 0.5}
+)");
+  ASSERT_TRUE(s.map && s.world && s.laser);
+  EXPECT_DOUBLE_EQ(s.world->resolution_m(), 0.02);
+  // A face at x = 1.03: the map's cell [1.0, 1.1) is occupied (its centre lies in the obstacle),
+  // and so is the room's [1.02, 1.04): 2 cm apart where the laser meets them.
+  EXPECT_NEAR(*s.map->cast_ray({0.5, 1.25}, 0.0, 10.0), 0.5, 1e-9);
+  EXPECT_NEAR(*s.world->cast_ray({0.5, 1.25}, 0.0, 10.0), 0.52, 1e-9);
+  EXPECT_TRUE(s.world->occupied_at({2.51, 1.01}));
+  EXPECT_FALSE(s.map->occupied_at({2.51, 1.01}));
+  ASSERT_EQ(s.people.size(), 1u);
+  EXPECT_TRUE(s.people[0].at(2.5).centre_m.isApprox(Eigen::Vector2d(2.5, 0.5)));
+  EXPECT_DOUBLE_EQ(s.laser->systematic_error_m, 0.025);
+  EXPECT_DOUBLE_EQ(s.laser->spot.divergence_rad, 0.011);
+  EXPECT_DOUBLE_EQ(s.laser->spot.echo_merge_m, 0.5);
+  EXPECT_NE(error_of(std::string(kMinimal) + "people:\n  - {path_m: [[0, 0]]}\n")
+                .find("'people[0].path_m' must list 2 to 1000 points"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kMinimal) + "people:\n  - {path_m: [[1, 1], [1, 1]]}\n").find("finite length"),
+            std::string::npos);
+  std::string crowd = std::string(kMinimal) + "people:\n";
+  for (int i = 0; i < 101; ++i) crowd += "  - {path_m: [[0, 0], [1, 1]]}\n";
+  EXPECT_NE(error_of(crowd).find("'people' may list at most 100 walkers"), std::string::npos);
+  EXPECT_NE(error_of(std::string(kMinimal) + "map: {size_m: [4, 3], world_resolution_m: 0.5}\n")
+                .find("'map.world_resolution_m' must be in"),
+            std::string::npos);
+}
+
 TEST(ScenarioYaml, ErrorsNameTheKeyAndLine) {
   EXPECT_EQ(error_of(std::string(kMinimal) + "colour: red\n"), "test.yaml:9: 'colour' is not a known key");
   EXPECT_NE(error_of(std::string(kMinimal) + "beacon_system: {range_sigma_m: -1}\n")

@@ -7,6 +7,7 @@
 #include <map>
 
 #include "beaconloc/core/speed_of_sound.hpp"
+#include "sim/laser_world.hpp"
 #include "sim/sim_source.hpp"
 
 namespace beaconloc::sim {
@@ -182,6 +183,57 @@ TEST(SimPhysics, LaserRaysAreCastOnTheMap) {
     EXPECT_NEAR(e.scan.angle_min_rad, -M_PI / 2, 1e-6);
   }
   EXPECT_EQ(scans, 2);
+}
+
+TEST(SimPhysics, AWalkerGoesThereAndBackAtItsSpeed) {
+  const Walker w({{0.0, 0.0}, {2.0, 0.0}, {2.0, 1.0}}, 0.5, 0.2);  // 3 m of path at 0.5 m/s
+  EXPECT_TRUE(w.at(0.0).centre_m.isApprox(Eigen::Vector2d(0.0, 0.0)));
+  EXPECT_TRUE(w.at(2.0).centre_m.isApprox(Eigen::Vector2d(1.0, 0.0)));
+  EXPECT_TRUE(w.at(5.0).centre_m.isApprox(Eigen::Vector2d(2.0, 0.5)));
+  EXPECT_TRUE(w.at(6.0).centre_m.isApprox(Eigen::Vector2d(2.0, 1.0)));   // the end: turns back
+  EXPECT_TRUE(w.at(8.0).centre_m.isApprox(Eigen::Vector2d(2.0, 0.0)));
+  EXPECT_TRUE(w.at(12.0).centre_m.isApprox(Eigen::Vector2d(0.0, 0.0)));  // back at the start
+  EXPECT_TRUE(w.at(-1.0).centre_m.isApprox(Eigen::Vector2d(0.0, 0.0)));
+  EXPECT_TRUE(w.at(std::nan("")).centre_m.allFinite());
+  EXPECT_DOUBLE_EQ(w.at(1.0).radius_m, 0.2);
+  // A zero-length leg within the path is walked through.
+  const Walker z({{0.0, 0.0}, {1.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}}, 1.0, 0.2);
+  EXPECT_TRUE(z.at(1.5).centre_m.isApprox(Eigen::Vector2d(1.0, 0.5)));
+  EXPECT_THROW(Walker({{0.0, 0.0}, {0.0, 0.0}}, 1.0, 0.2), std::invalid_argument);
+  EXPECT_THROW(Walker({{0.0, 0.0}}, 1.0, 0.2), std::invalid_argument);
+}
+
+TEST(SimPhysics, TheLaserSeesWalkersInFrontOfTheWallButNotOneItStandsIn) {
+  OccupancyGrid room({0.0, 0.0}, 0.1, 40, 30);
+  room.fill_border();  // the wall ahead (+x) at x = 3.9
+  const Eigen::Vector2d from(1.0, 1.5);
+  std::vector<Disc> people{{{2.5, 1.5}, 0.25}};
+  EXPECT_NEAR(*first_surface_m(room, people, from, 0.0, 80.0), 1.25, 1e-9);       // the person's front
+  EXPECT_NEAR(*first_surface_m(room, people, from, M_PI / 2, 80.0), 1.4, 1e-9);  // beside: the wall
+  people.push_back({{1.0, 1.5}, 0.3});  // one where the scanner is: not seen
+  EXPECT_NEAR(*first_surface_m(room, people, from, 0.0, 80.0), 1.25, 1e-9);
+  EXPECT_FALSE(first_surface_m(room, {}, from, 0.0, 2.0));  // nothing within 2 m
+}
+
+TEST(SimPhysics, ASpotAcrossAnEdgeReadsAMixedPixelOrTheFirstEcho) {
+  // A 4 m x 3 m room on 1 cm cells (walls' inner faces at x = 3.99, y = 2.99) and a box whose
+  // face (x = 3.5) ends at y = 1.5: the beam along y = 1.5 straddles its edge.
+  OccupancyGrid room({0.0, 0.0}, 0.01, 400, 300);
+  room.fill_border();
+  room.fill_rectangle({3.5, 0.0}, {3.6, 1.5});
+  const Eigen::Vector2d from(0.5, 1.5);
+  constexpr double kBoxM = 3.0, kWallM = 3.49;
+  LaserSpot wide{0.013, 0.011, 0.5};  // the LMS5xx spot (laser_world.hpp), echoes within 0.5 m merge
+  const double mixed = *spot_reading_m(room, {}, wide, from, 0.0, 80.0);
+  EXPECT_GT(mixed, kBoxM + 0.05);  // between the box's face and the wall
+  EXPECT_LT(mixed, kWallM - 0.05);
+  wide.echo_merge_m = 0.1;  // echoes that do not merge: the first (the box) is read
+  EXPECT_NEAR(*spot_reading_m(room, {}, wide, from, 0.0, 80.0), kBoxM, 0.01);
+  // Away from any edge the spot reads what the ideal ray reads (the wall ahead, +y).
+  EXPECT_NEAR(*spot_reading_m(room, {}, wide, from, M_PI / 2, 80.0), 1.49, 0.01);
+  // The ideal ray reads one surface or the other, never between.
+  const double axis = *spot_reading_m(room, {}, LaserSpot{}, from, 0.0, 80.0);
+  EXPECT_TRUE(std::abs(axis - kBoxM) < 1e-9 || std::abs(axis - kWallM) < 1e-9) << axis;
 }
 
 }  // namespace

@@ -201,11 +201,14 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
   TruthTrack truth;
   std::vector<EstimateRow> rows;
   const std::vector<SourceEvent> events = simulate(scenario, seed, scenario.duration_s);
+  OfflineRunResult result;
   for (const auto& e : deliver(events, delivery, seed)) {
     if (e.kind == SourceEvent::Kind::kOdometry) truth.add(e.stamp_ns, e.truth_map_base);
-    if (auto pose = stack.feed("robot", e)) rows.push_back({"robot", pose->estimate, estimator});
+    if (auto pose = stack.feed("robot", e)) {
+      rows.push_back({"robot", pose->estimate, estimator});
+      if (!pose->state.empty()) result.last_state = pose->state;
+    }
   }
-  OfflineRunResult result;
   result.poses = rows.size();
   result.associations = stack.associations;
   result.rejections.add_rejections(stack.decoder.counts(), "decoder.");

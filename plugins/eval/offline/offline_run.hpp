@@ -75,6 +75,7 @@ struct OfflineRunResult {
   RejectionCounter rejections;  // decoder.<reason> and localizer.<reason>
   std::uint64_t replays = 0;    // late measurements fused at their stamp by rolling back
   PoseBoundResult bound;  // the posterior Cramer-Rao bound over the stamps scored (pose_bound.hpp)
+  std::vector<Estimator::StateValue> last_state;  // the estimator's state as last published
 };
 
 // How the measurements reach the localizer: in stamp order, or each TOF and scan late by a

@@ -13,6 +13,7 @@
 #include "beaconloc/core/occupancy_grid.hpp"
 #include "beaconloc/core/receiver_array.hpp"
 #include "beaconloc/core/time.hpp"
+#include "laser_world.hpp"
 #include "trajectory.hpp"
 
 namespace beaconloc::sim {
@@ -34,7 +35,9 @@ struct LaserModel {
   int beams = 19;
   double fov_rad = M_PI;
   StampNs period_ns = 22 * kNsPerMillisecond;
-  double range_sigma_m = 0.1;
+  double range_sigma_m = 0.1;       // statistical error: drawn for every reading
+  double systematic_error_m = 0.0;  // each beam's own fixed error, uniform in [-e, e], drawn once a run
+  LaserSpot spot;                   // ideal by default: the surface on the beam's axis
   double max_range_m = 8.0;
   Pose2 mount_base = Pose2::Zero();  // in the robot frame
 };
@@ -105,8 +108,10 @@ struct Scenario {
 
   Trajectory trajectory;
   std::optional<OccupancyGrid> map;
-  // The world the laser sees when it differs from the map (unmapped obstacles); none: the map.
+  // The world the laser sees when it differs from the map (unmapped obstacles, or the room's
+  // surfaces on a finer grid than the map's); none: the map.
   std::optional<OccupancyGrid> world;
+  std::vector<Walker> people;  // moving, in no map: only the laser sees them
   std::optional<LaserModel> laser;
 };
 

@@ -328,7 +328,8 @@ void read_trajectory(const Section& root, Scenario& sc) {
 void read_map_and_laser(const Section& root, Scenario& sc) {
   if (root.has("map")) {
     const Section m = root.child(
-        "map", {"resolution_m", "origin_m", "size_m", "border", "obstacles", "unmapped_obstacles"});
+        "map", {"resolution_m", "origin_m", "size_m", "border", "obstacles", "unmapped_obstacles",
+                "world_resolution_m"});
     const double res =
         m.number("resolution_m", 0.1, OccupancyGrid::kMinResolutionM, OccupancyGrid::kMaxResolutionM);
     if (!m.has("size_m")) m.fail(m.join("size_m"), "is required", root.node("map"));
@@ -347,8 +348,9 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
     const int height = static_cast<int>(std::ceil(size.y() / res - 1e-9));
     if (width < 1 || height < 1)
       m.fail(m.join("size_m"), "must be at least one cell a side", m.node("size_m"));
+    const bool border = m.get<bool>("border", true);
     OccupancyGrid grid(origin, res, width, height);
-    if (m.get<bool>("border", true)) grid.fill_border();
+    if (border) grid.fill_border();
     auto fill = [&](const char* key, OccupancyGrid& target) {
       const YAML::Node list = m.node(key);
       for (std::size_t i = 0; list && list.IsSequence() && i < list.size(); ++i) {
@@ -363,8 +365,22 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
     };
     fill("obstacles", grid);
     sc.map = grid;
+    if (m.has("world_resolution_m")) {
+      // The room as built, on its own finer grid: the same obstacles, their faces where the
+      // coordinates put them rather than on the map's cell edges.
+      const double world_res = m.number("world_resolution_m", res, OccupancyGrid::kMinResolutionM, res);
+      if ((size.x() / world_res) * (size.y() / world_res) > static_cast<double>(OccupancyGrid::kMaxCells) ||
+          size.maxCoeff() / world_res > OccupancyGrid::kMaxCellsPerSide) {
+        m.fail(m.join("world_resolution_m"), "makes too many cells for the map's size", m.node("world_resolution_m"));
+      }
+      OccupancyGrid world(origin, world_res, static_cast<int>(std::ceil(size.x() / world_res - 1e-9)),
+                          static_cast<int>(std::ceil(size.y() / world_res - 1e-9)));
+      if (border) world.fill_border();
+      fill("obstacles", world);
+      sc.world = world;
+    }
     if (m.has("unmapped_obstacles")) {  // in the world the laser sees, not in the map
-      OccupancyGrid world = grid;
+      OccupancyGrid world = sc.world ? *sc.world : grid;
       fill("unmapped_obstacles", world);
       sc.world = world;
     }
@@ -372,16 +388,53 @@ void read_map_and_laser(const Section& root, Scenario& sc) {
   if (root.has("laser")) {
     if (!sc.map) root.fail("laser", "needs a map to cast its rays on", root.node("laser"));
     const Section l =
-        root.child("laser", {"beams", "fov_deg", "period_s", "range_sigma_m", "max_range_m", "mount_m"});
+        root.child("laser", {"beams", "fov_deg", "period_s", "range_sigma_m", "systematic_error_m",
+                             "spot_diameter_at_window_m", "spot_divergence_rad", "echo_merge_m", "max_range_m",
+                             "mount_m"});
     LaserModel laser;
     laser.beams = l.integer("beams", 19, 1, 4096);
     laser.fov_rad = l.number("fov_deg", 180.0, 0.0, 360.0) * M_PI / 180.0;
     laser.period_ns = duration_ns(l, "period_s", 0.022);
     laser.range_sigma_m = l.number("range_sigma_m", 0.1, 0.0, 10.0);
+    laser.systematic_error_m = l.number("systematic_error_m", 0.0, 0.0, 10.0);
+    laser.spot.diameter_at_window_m = l.number("spot_diameter_at_window_m", 0.0, 0.0, 1.0);
+    laser.spot.divergence_rad = l.number("spot_divergence_rad", 0.0, 0.0, 0.1);
+    laser.spot.echo_merge_m = l.number("echo_merge_m", 0.0, 0.0, 10.0);
     laser.max_range_m = l.number("max_range_m", 8.0, 0.01, 1e3);
     if (l.has("mount_m"))
       laser.mount_base = vec3(l, l.node("mount_m"), l.join("mount_m"), kMaxReceiverOffsetM);
     sc.laser = laser;
+  }
+}
+
+// People walking (Walker): each a path of at least two points, a speed and a radius. At most
+// kMaxPeople of kMaxPathPoints each: every scan casts its rays against every one.
+constexpr std::size_t kMaxPeople = 100;
+constexpr std::size_t kMaxPathPoints = 1000;
+
+void read_people(const Section& root, Scenario& sc) {
+  if (!root.has("people")) return;
+  const YAML::Node list = root.node("people");
+  if (!list.IsSequence()) root.fail("people", "must list walkers", list);
+  if (list.size() > kMaxPeople) root.fail("people", "may list at most " + std::to_string(kMaxPeople) + " walkers", list);
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const Section w(list[i], "people[" + std::to_string(i) + "]", root.origin(),
+                    {"path_m", "speed_mps", "radius_m"});
+    const YAML::Node path = w.node("path_m");
+    if (!path || !path.IsSequence() || path.size() < 2 || path.size() > kMaxPathPoints) {
+      w.fail(w.join("path_m"), "must list 2 to " + std::to_string(kMaxPathPoints) + " points", list[i]);
+    }
+    std::vector<Eigen::Vector2d> points;
+    for (std::size_t k = 0; k < path.size(); ++k) {
+      points.push_back(vec2(w, path[k], w.join("path_m") + "[" + std::to_string(k) + "]", kMaxMapCoordinateM));
+    }
+    const double speed = w.number("speed_mps", 1.0, 1e-3, 10.0);
+    const double radius = w.number("radius_m", 0.2, 0.01, 5.0);
+    try {
+      sc.people.emplace_back(std::move(points), speed, radius);
+    } catch (const std::invalid_argument& e) {
+      w.fail(w.join("path_m"), e.what(), list[i]);
+    }
   }
 }
 
@@ -396,7 +449,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
   }
   const Section root(doc, "", origin,
                      {"name", "description", "seed", "duration_s", "score_from_s", "beacons", "groups",
-                      "beacon_system", "robot", "trajectory", "map", "laser"});
+                      "beacon_system", "robot", "trajectory", "map", "laser", "people"});
   Scenario sc;
   sc.name = root.required<std::string>("name");
   sc.description = root.get<std::string>("description", "");
@@ -409,6 +462,7 @@ Scenario parse_scenario(const std::string& yaml_text, const std::string& origin)
   read_robot(root, sc);
   read_trajectory(root, sc);
   read_map_and_laser(root, sc);
+  read_people(root, sc);
   return sc;
 }
 

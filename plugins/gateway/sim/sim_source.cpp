@@ -45,7 +45,15 @@ SimSource::SimSource(Scenario scenario, std::uint64_t seed)
       next_odometry_ns_(scenario_.odometry_period_ns),
       next_fire_ns_(scenario_.first_slot_ns),
       next_scan_ns_(scenario_.laser ? scenario_.laser->period_ns : std::numeric_limits<StampNs>::max()),
-      group_centres_map_m_(scenario_.group_centres_map_m()) {}
+      group_centres_map_m_(scenario_.group_centres_map_m()) {
+  // LaserModel::systematic_error_m: each beam's fixed error, drawn once (only when there is one,
+  // so that the random stream of every other scenario is as it was).
+  if (scenario_.laser && scenario_.laser->systematic_error_m > 0.0) {
+    for (int i = 0; i < scenario_.laser->beams; ++i) {
+      beam_errors_m_.push_back(scenario_.laser->systematic_error_m * (2.0 * uniform() - 1.0));
+    }
+  }
+}
 
 void SimSource::set_firing_plan(std::optional<std::vector<std::uint32_t>> beacon_ids) {
   if (beacon_ids) {
@@ -192,13 +200,16 @@ SourceEvent SimSource::scan_at(StampNs stamp_ns) {
   e.scan.angle_increment_rad = static_cast<float>(increment);
   e.scan.range_min_m = 0.0f;
   e.scan.range_max_m = static_cast<float>(laser.max_range_m);
+  const OccupancyGrid& world = scenario_.world ? *scenario_.world : *scenario_.map;
+  const std::vector<Disc> people = discs_at(scenario_.people, ns_to_s(stamp_ns));
   for (int i = 0; i < laser.beams; ++i) {
     const double angle = sensor.z() - laser.fov_rad / 2.0 + i * increment;
-    const OccupancyGrid& world = scenario_.world ? *scenario_.world : *scenario_.map;
-    const auto hit = world.cast_ray(sensor.head<2>(), angle, laser.max_range_m);
+    const auto hit = spot_reading_m(world, people, laser.spot, sensor.head<2>(), angle, laser.max_range_m);
     const double noise = normal();  // drawn for every beam: the stream does not depend on hits
-    e.scan.ranges_m.push_back(hit ? static_cast<float>(std::max(0.0, *hit + laser.range_sigma_m * noise))
-                                  : std::numeric_limits<float>::infinity());
+    const double systematic_m = beam_errors_m_.empty() ? 0.0 : beam_errors_m_[static_cast<std::size_t>(i)];
+    e.scan.ranges_m.push_back(
+        hit ? static_cast<float>(std::max(0.0, *hit + systematic_m + laser.range_sigma_m * noise))
+            : std::numeric_limits<float>::infinity());
   }
   return e;
 }

@@ -82,6 +82,7 @@ class SimSource final : public Source {
   std::uint64_t tof_sequence_ = 0;
   std::priority_queue<SourceEvent, std::vector<SourceEvent>, Later> pending_tofs_;
   std::map<std::uint32_t, Eigen::Vector2d> group_centres_map_m_;  // for group_coverage_radius_m
+  std::vector<double> beam_errors_m_;  // LaserModel::systematic_error_m, per beam; empty: none
 };
 
 // Arrival time of a pulse fired at fire_s from `beacon` at the receiver mounted at

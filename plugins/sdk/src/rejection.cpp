@@ -52,6 +52,7 @@ const char* to_string(Rejection r) {
     case Rejection::kNonFiniteModel: return "non_finite_model";
     case Rejection::kSizeMismatch: return "size_mismatch";
     case Rejection::kStaleSigmaPoints: return "stale_sigma_points";
+    case Rejection::kEveryComponentGated: return "every_component_gated";
     case Rejection::kNoInitialPose: return "no_initial_pose";
     case Rejection::kResetUnsupported: return "reset_unsupported";
     case Rejection::kInvalidInitialPose: return "invalid_initial_pose";
@@ -78,6 +79,7 @@ std::optional<Rejection> rejection_for(FilterOutcome outcome) {
     case FilterOutcome::kNonFinite: return Rejection::kNonFiniteModel;
     case FilterOutcome::kSizeMismatch: return Rejection::kSizeMismatch;
     case FilterOutcome::kStaleSigmaPoints: return Rejection::kStaleSigmaPoints;
+    case FilterOutcome::kEveryComponentGated: return Rejection::kEveryComponentGated;
     case FilterOutcome::kApplied: return std::nullopt;
   }
   return Rejection::kNonFiniteModel;  // an outcome outside the enumeration: refused all the same

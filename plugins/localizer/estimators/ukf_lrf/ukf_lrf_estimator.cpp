@@ -1,6 +1,7 @@
 #include "ukf_lrf_estimator.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "beaconloc/core/estimator_parameters.hpp"
@@ -60,7 +61,12 @@ UkfLrfParameters UkfLrfParameters::from(const EstimatorConfig& c, const std::str
   // N_W: the augmented state grows by one per beam (a 1000-beam state is a 1000 x 1000 Cholesky a scan).
   p.max_beams = in.count("max_beams", p.max_beams, 1, 1000);
   p.max_measurement_age_s = in.real("max_measurement_age_s", p.max_measurement_age_s, ranges::kDataDurationS);
+  // 0: no gate (the paper's eq. 16-21). Below 1 sigma most good beams would be refused.
+  p.beam_gate_sigma = in.real("beam_gate_sigma", p.beam_gate_sigma, ParameterRange::closed(0.0, 100.0));
   in.finish();
+  if (p.beam_gate_sigma > 0.0 && p.beam_gate_sigma < 1.0) {
+    throw std::invalid_argument(estimator + ": beam_gate_sigma must be 0 (no gate) or in [1, 100]");
+  }
   if (p.initial_pose && !p.initial_pose->allFinite()) {
     throw std::invalid_argument(estimator + ": the initial pose must be finite");
   }
@@ -252,7 +258,14 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
   Eigen::VectorXd z(n_b + n_w);
   for (int k = 0; k < n_b; ++k) z(k) = ranges[k].range_m;
   for (int k = 0; k < n_w; ++k) z(n_b + k) = scan->ranges_m[k];
-  const UpdateResult corrected_by = filter_.update(*points, model, z);  // eq. 15-22
+  // Eq. 15-22, the beams that are gross outliers on their own left out (beam_gate_sigma).
+  const UpdateResult corrected_by = filter_.update(
+      *points, model, z, std::numeric_limits<double>::infinity(),
+      params_.beam_gate_sigma > 0.0 ? ComponentGate{n_b, n_w, params_.beam_gate_sigma} : ComponentGate{});
+  // Counted when they were left out: of an update applied, or one that had nothing else to fuse.
+  if (corrected_by.applied() || corrected_by.outcome == FilterOutcome::kEveryComponentGated) {
+    beams_gated_ += static_cast<std::uint64_t>(corrected_by.components_gated);
+  }
   if (!corrected_by.applied()) return InputResult::of(corrected_by.outcome);
   corrected(*now_ns());
   for (int k = 0; k < n_b; ++k) {
@@ -292,6 +305,10 @@ std::optional<std::vector<std::uint32_t>> UkfLrf::associate(const std::vector<Ra
     out.push_back(*j);
   }
   return out;
+}
+
+std::vector<Estimator::StateValue> UkfLrf::state_values() const {
+  return {{"beams_gated", static_cast<double>(beams_gated_), 0.0}};
 }
 
 std::vector<Estimator::Association> UkfLrf::take_associations() {

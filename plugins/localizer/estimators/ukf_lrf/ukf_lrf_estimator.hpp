@@ -36,6 +36,13 @@ struct UkfLrfParameters {
   double max_odometry_gap_s = kDefaultMaxOdometryGapS;
   int max_beams = 19;                  // N_W of Sec. 3.4: longer scans are thinned evenly
   double max_measurement_age_s = 0.1;  // a range or scan older than this behind the filter is stale
+  // Departure from eq. 16-21 (which fuse every beam): a beam whose reading is more than this many
+  // of its own predicted standard deviations from the ray cast (|z_i - z_i_mean| > g sqrt(S_ii),
+  // eq. 18-19) is left out of the update (ComponentGate), counted in `beams_gated`. In a room
+  // the map does not fully know (people, furniture moved in), such beams met something the map
+  // lacks; fused, a few of them pull the pose off the corridor. 0: no gate, every beam fused as
+  // the paper does.
+  double beam_gate_sigma = 3.0;
 
   // estimator: the mode's registered name, for the messages.
   static UkfLrfParameters from(const EstimatorConfig& config, const std::string& estimator);
@@ -53,6 +60,7 @@ class UkfLrf final : public EstimatorBase {
   InputResult update_laser(const LaserScanSample& scan) override;
   std::vector<Association> take_associations() override;
   std::vector<Rejection> take_deferred_rejections() override;
+  std::vector<StateValue> state_values() const override;
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<UkfLrf>(*this); }
 
  private:
@@ -92,6 +100,7 @@ class UkfLrf final : public EstimatorBase {
   std::optional<ScanBeams> pending_scan_;
   StampNs pending_scan_stamp_ns_ = 0;
   bool last_step_predicted_ = false;
+  std::uint64_t beams_gated_ = 0;  // UkfLrfParameters::beam_gate_sigma
   std::vector<Association> associations_;
   std::vector<Rejection> deferred_rejections_;
 };

@@ -272,6 +272,45 @@ TEST(UkfLrfEstimator, HoldsAScanAheadOfTheOdometryRefusesStaleAndThinsLongScans)
   EXPECT_EQ(drive.ukf_->update_laser(no_increment).rejection, Rejection::kMalformedScan);
 }
 
+// A person in front of the scanner: the beams that meet them read short of the map and are left
+// out, the others fused; a scan whose every beam is so is refused by reason.
+TEST(UkfLrfEstimator, LeavesOutBeamsShortOfTheMapAndRefusesAScanOfNothingElse) {
+  RoomDrive drive("ukf_lrf_laser_only");
+  ASSERT_TRUE(drive.odometry(0, 0.0).accepted);
+  ASSERT_TRUE(drive.odometry(22'000'000, 0.0).accepted);
+  const Pose2 before = drive.ukf_->estimate()->pose_map_base;
+  const double trace_before = drive.ukf_->estimate()->covariance.trace();
+  LaserScanSample person = drive.scan(22'000'000);
+  for (std::size_t i = 7; i <= 11; ++i) person.ranges_m[i] = 0.6f;  // five beams ahead, 0.6 m: someone
+  ASSERT_TRUE(drive.ukf_->update_laser(person).accepted);
+  EXPECT_LT(drive.ukf_->estimate()->covariance.trace(), trace_before);  // the other 14 fused
+  EXPECT_LT((drive.ukf_->estimate()->pose_map_base.head<2>() - before.head<2>()).norm(), 0.01);
+  const auto gated = [&] {
+    for (const Estimator::StateValue& v : drive.ukf_->state_values()) {
+      if (v.name == "beams_gated") return v.value;
+    }
+    return -1.0;
+  };
+  EXPECT_EQ(gated(), 5.0);
+  LaserScanSample crowd = drive.scan(22'000'000);
+  for (float& r : crowd.ranges_m) r = 0.3f;  // everything a person: nothing the map explains
+  EXPECT_EQ(drive.ukf_->update_laser(crowd).rejection, Rejection::kEveryComponentGated);
+  EXPECT_EQ(gated(), 5.0 + 19.0);
+  // Without the gate (beam_gate_sigma=0, the paper's eq. 16-21), the person's beams pull the pose.
+  EstimatorConfig config;
+  config.receivers.receivers_base_m = {{0.0, 0.0}};
+  config.occupancy_grid = std::make_shared<const OccupancyGrid>(room());
+  config.initial_pose = drive.truth_;
+  config.parameters = {{"beam_gate_sigma", 0.0}};
+  auto ungated = EstimatorRegistry::instance().create("ukf_lrf_laser_only", config);
+  OdometrySample o;
+  o.wheel_base_m = 0.4;
+  o.stamp_ns = 22'000'000;
+  ASSERT_TRUE(ungated->predict(o).accepted);
+  ASSERT_TRUE(ungated->update_laser(person).accepted);
+  EXPECT_GT((ungated->estimate()->pose_map_base.head<2>() - before.head<2>()).norm(), 0.02);
+}
+
 TEST(UkfLrfEstimator, EveryPlaceableEstimatorRestartsFromAGivenPose) {
   EstimatorConfig config;
   config.receivers = ReceiverArray::on_circle(0.19, 3);
@@ -304,6 +343,8 @@ TEST(UkfLrfEstimator, RefusesBadParametersAtStart) {
                                                                                {"alpha1", -0.01},
                                                                                {"beacon_sigma_m", 0.0},
                                                                                {"max_beams", 0.0},
+                                                                               {"beam_gate_sigma", 0.5},
+                                                                               {"beam_gate_sigma", -1.0},
                                                                                {"ut_kappa", -10.0}}) {
     config.parameters = {{name, value}};
     EXPECT_THROW(EstimatorRegistry::instance().create("ukf_lrf_beacons_only", config), std::invalid_argument)

@@ -67,6 +67,7 @@ enum class Rejection : std::uint8_t {
   kNonFiniteModel,
   kSizeMismatch,
   kStaleSigmaPoints,
+  kEveryComponentGated,  // every beam of a scan (every component) an outlier on its own
   // Placing an estimator.
   kNoInitialPose,
   kResetUnsupported,

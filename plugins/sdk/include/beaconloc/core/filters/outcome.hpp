@@ -14,14 +14,19 @@ enum class FilterOutcome : std::uint8_t {
   kNonFinite,           // the model gave a non-finite prediction, Jacobian or noise
   kSizeMismatch,        // z, R or the Jacobian do not have the model's or the state's size
   kStaleSigmaPoints,    // UKF: sigma points drawn for another belief or another R (ukf.hpp)
+  kEveryComponentGated, // UKF ComponentGate: every component an outlier on its own, nothing to fuse
 };
 const char* to_string(FilterOutcome outcome);
 
 struct UpdateResult {
   FilterOutcome outcome = FilterOutcome::kApplied;
-  double nis = 0.0;    // normalized innovation squared nu^T S^-1 nu (at the prior)
-  double log_det_s = 0.0;  // log det S (at the prior): with nis, the innovation's likelihood
+  // At the prior, over the components fused (a UKF ComponentGate's gated ones left out):
+  double nis = 0.0;    // normalized innovation squared nu^T S^-1 nu
+  double log_det_s = 0.0;  // log det S: with nis, the innovation's likelihood
   int iterations = 0;  // linearizations made (1 for the EKF, up to the cap for the IEKF)
+  // UKF ComponentGate: components found outliers on their own (left out of the update when it
+  // is applied; all of them when the outcome is kEveryComponentGated).
+  int components_gated = 0;
   bool applied() const { return outcome == FilterOutcome::kApplied; }
 };
 

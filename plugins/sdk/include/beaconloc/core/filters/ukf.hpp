@@ -14,12 +14,16 @@
 //    predict(motion, u, dt, R) moves them and keeps them (SigmaPoints), the caller may look at the
 //    moved points (seed 001 Table 2 associates beacons over them), and update(points, model, z)
 //    corrects with the same points. sigma_points(R) draws such a set without a motion.
+//  - A ComponentGate leaves the components of a vector measurement that are gross outliers on
+//    their own (|nu_i| > g sqrt(S_ii)) out of the update, and fuses the rest.
 // Sizes of the augmented sets are known at run time only: dynamic Eigen types inside.
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include "beaconloc/core/filters/gaussian_filter.hpp"
 #include "beaconloc/core/filters/unscented.hpp"
@@ -29,6 +33,18 @@ namespace beaconloc {
 struct UkfOptions {
   UnscentedParameters unscented;
   bool augment_measurement_noise = false;
+};
+
+// Components [first, first + count) of a measurement whose innovation is more than `sigmas`
+// times their own predicted standard deviation (|nu_i| > sigmas sqrt(S_ii)) are left out of the
+// update one by one: the others are fused as if those had not been measured (their rows and
+// columns of S and P_xz dropped, which is exact). For a vector of independent readings of which
+// a few may be gross outliers (laser beams that met what the map does not have). The default,
+// or a gate that is not a positive number, leaves every component in.
+struct ComponentGate {
+  Eigen::Index first = 0;
+  Eigen::Index count = 0;
+  double sigmas = std::numeric_limits<double>::infinity();
 };
 
 template <int N>
@@ -142,7 +158,7 @@ class Ukf : public GaussianFilter<N> {
 
   template <class Model>
   UpdateResult update(const Model& model, const typename Model::Vector& z,
-                      double nis_gate = std::numeric_limits<double>::infinity()) {
+                      double nis_gate = std::numeric_limits<double>::infinity(), ComponentGate gate = {}) {
     const Eigen::MatrixXd r = model.noise();
     UpdateResult result;
     result.iterations = 1;
@@ -153,7 +169,7 @@ class Ukf : public GaussianFilter<N> {
       result.outcome = FilterOutcome::kNotPositiveDefinite;
       return result;
     }
-    return correct(*points, model, z, r, nis_gate);
+    return correct(*points, model, z, r, nis_gate, gate);
   }
 
   // Seed 001 eq. 15-22 over points drawn for this belief: z_i = h(x_i) (+ v_i, eq. 16), their
@@ -161,7 +177,7 @@ class Ukf : public GaussianFilter<N> {
   // (eq. 21-22). kStaleSigmaPoints when the belief or R is not the one they were drawn for.
   template <class Model>
   UpdateResult update(const SigmaPoints<N>& points, const Model& model, const typename Model::Vector& z,
-                      double nis_gate = std::numeric_limits<double>::infinity()) {
+                      double nis_gate = std::numeric_limits<double>::infinity(), ComponentGate gate = {}) {
     UpdateResult result;
     result.iterations = 1;
     const Eigen::MatrixXd r = model.noise();
@@ -171,7 +187,7 @@ class Ukf : public GaussianFilter<N> {
       result.outcome = FilterOutcome::kStaleSigmaPoints;
       return result;
     }
-    return correct(points, model, z, r, nis_gate);
+    return correct(points, model, z, r, nis_gate, gate);
   }
 
  private:
@@ -179,7 +195,7 @@ class Ukf : public GaussianFilter<N> {
   // this belief's, drawn for r.
   template <class Model>
   UpdateResult correct(const SigmaPoints<N>& points, const Model& model, const typename Model::Vector& z,
-                       const Eigen::MatrixXd& r, double nis_gate) {
+                       const Eigen::MatrixXd& r, double nis_gate, ComponentGate gate) {
     UpdateResult result;
     result.iterations = 1;
     const Eigen::Index m = model.size();
@@ -221,13 +237,17 @@ class Ukf : public GaussianFilter<N> {
     }
     Eigen::MatrixXd s = weighted_covariance(z_centred, w);  // eq. 19
     if (!augmented) s += r;
-    const Eigen::MatrixXd xz = weighted_cross_covariance(points.deviations_, z_centred, w);  // eq. 20
+    Eigen::MatrixXd xz = weighted_cross_covariance(points.deviations_, z_centred, w);  // eq. 20
+    Eigen::VectorXd innovation = model.residual(z, z_mean);
+    if (!leave_out_gated(gate, innovation, s, xz, result.components_gated)) {
+      result.outcome = FilterOutcome::kEveryComponentGated;
+      return result;
+    }
     const InnovationFactor<Eigen::Dynamic> factor(s);
     if (!factor.ok()) {
       result.outcome = FilterOutcome::kSingularInnovation;
       return result;
     }
-    const Eigen::VectorXd innovation = model.residual(z, z_mean);
     result.nis = factor.nis(innovation);
     result.log_det_s = factor.log_det();
     if (!(result.nis <= nis_gate)) {
@@ -246,6 +266,32 @@ class Ukf : public GaussianFilter<N> {
     return result;
   }
 
+  // ComponentGate: drops the gated components' rows of the innovation, rows and columns of S and
+  // columns of P_xz, counting them; false when nothing is left to fuse.
+  static bool leave_out_gated(const ComponentGate& gate, Eigen::VectorXd& innovation, Eigen::MatrixXd& s,
+                              Eigen::MatrixXd& xz, int& gated) {
+    if (!(gate.sigmas > 0.0)) return true;  // no gate (and a NaN one gates nothing)
+    const Eigen::Index m = innovation.size();
+    const Eigen::Index first = std::clamp<Eigen::Index>(gate.first, 0, m);
+    const Eigen::Index last = first + std::clamp<Eigen::Index>(gate.count, 0, m - first);
+    std::vector<Eigen::Index> kept;
+    kept.reserve(static_cast<std::size_t>(m));
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const bool gated_out =
+          i >= first && i < last && !(innovation(i) * innovation(i) <= gate.sigmas * gate.sigmas * s(i, i));
+      if (gated_out) {
+        ++gated;
+      } else {
+        kept.push_back(i);
+      }
+    }
+    if (gated == 0) return true;
+    if (kept.empty()) return false;
+    innovation = Eigen::VectorXd(innovation(kept));
+    s = Eigen::MatrixXd(s(kept, kept));
+    xz = Eigen::MatrixXd(xz(Eigen::all, kept));
+    return true;
+  }
   template <class A, class B>
   static bool same(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>& b) {
     return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
