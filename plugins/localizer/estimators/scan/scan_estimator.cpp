@@ -185,7 +185,7 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   if (now_ns() && r.stamp_ns > *now_ns() + s_to_ns(params_.epoch_window_s)) {
     return InputResult::rejected(Rejection::kAheadOfOdometry);
   }
-  if (auto last = last_range_.find(r.beacon_id); last != last_range_.end() && last->second.first == r.stamp_ns) {
+  if (auto last = last_range_.find(r.beacon_id); last != last_range_.end() && last->second.newest_ns == r.stamp_ns) {
     return InputResult::rejected(Rejection::kDuplicateRange);
   }
 
@@ -210,13 +210,34 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   if (epoch.ranges.size() >= kMaxEpochRanges) return InputResult::rejected(Rejection::kTooManyRangesInEpoch);
   record(r);
   std::optional<double> rate_mps;
+  bool an_echo = false;  // longer than the beacon's previous range allows
   if (auto last = last_range_.find(r.beacon_id); last != last_range_.end()) {
-    const StampNs dt_ns = r.stamp_ns - last->second.first;
-    // A range cannot change faster than the robot moves: a faster "rate" is an echo's.
-    if (dt_ns > 0 && dt_ns <= kRangeRateWindowNs) rate_mps = (r.range_m - last->second.second) / ns_to_s(dt_ns);
-    if (rate_mps && !(std::abs(*rate_mps) <= kMaxWheelSpeedMps)) rate_mps.reset();
+    const LastRange& before = last->second;
+    const StampNs dt_ns = r.stamp_ns - before.stamp_ns;
+    // A range cannot change by more than the receiver moved (the odometry's displacement, 5 % of
+    // it for the odometry's error, and 4 sigma of the two ranges): a larger change is an echo's
+    // (its extra path is 0.3 m or more), and its "rate" would move the range wrongly. An echo is
+    // longer than the direct path: this range, when it grew too much (kept out of the rates, the
+    // previous one stays the reference); the previous, when it shrank too much.
+    const Eigen::Vector2d& rx = receivers_.receivers_base_m[0];
+    const double moved_m = (transform_point(odometry_pose_, rx) - transform_point(before.odometry_pose, rx)).norm();
+    const double allowed_m = 1.05 * moved_m + 4.0 * std::sqrt(r.variance_m2 + before.variance_m2);
+    if (dt_ns > 0 && dt_ns <= kRangeRateWindowNs) {
+      if (std::abs(r.range_m - before.range_m) <= allowed_m) {
+        rate_mps = (r.range_m - before.range_m) / ns_to_s(dt_ns);
+      } else {
+        an_echo = r.range_m > before.range_m;
+      }
+    }
   }
-  last_range_[r.beacon_id] = {r.stamp_ns, r.range_m};
+  LastRange& last = last_range_[r.beacon_id];
+  last.newest_ns = r.stamp_ns;
+  if (!an_echo) {
+    last.stamp_ns = r.stamp_ns;
+    last.range_m = r.range_m;
+    last.variance_m2 = r.variance_m2;
+    last.odometry_pose = odometry_pose_;
+  }
   epoch.ranges.push_back({r.beacon_id, r.range_m, r.variance_m2, odometry_pose_, r.stamp_ns, rate_mps});
 
   if (params_.geometry == Geometry::kHyperbolic) return InputResult::ok();  // fused with its epoch
