@@ -204,6 +204,7 @@ class ScanEstimator final : public EstimatorBase {
   ScanParameters params_;
   StartupWait waiting_for_;
   Pose2 odometry_pose_ = Pose2::Zero();
+  StampNs odometry_integrated_ns_ = 0;  // the time the odometry integrated so far (gaps not)
   Frame global_;
   std::map<std::uint32_t, LocalGroup> local_;           // by group, the LRULPSs not calibrated yet
   std::map<std::uint32_t, CalibratedBeacon> calibrated_;  // by beacon id
@@ -216,6 +217,7 @@ class ScanEstimator final : public EstimatorBase {
     double range_m = 0.0;
     double variance_m2 = 0.0;
     Pose2 odometry_pose = Pose2::Zero();  // the dead-reckoned pose when it came
+    StampNs integrated_ns = 0;            // odometry_integrated_ns_ then
   };
   std::map<std::uint32_t, LastRange> last_range_;  // by beacon
   // Sec. 3.6: the inputs since the robot last left a GRULPS, and when it came back to one.
