@@ -151,6 +151,7 @@ InputResult ScanEstimator::predict(const OdometrySample& o) {
   odometry_pose_ =
       predict_diff_drive(odometry_pose_, o.wheel_velocity_right_mps, o.wheel_velocity_left_mps, o.wheel_base_m, step.dt_s)
           .pose;
+  odometry_integrated_ns_ += s_to_ns(step.dt_s);
   const auto advance_frame = [&](Frame& f) {
     if (f.started && f.relocating) {
       if (const PredictResult r = f.start.predict(o, step.dt_s, floor); !r.applied()) return r;
@@ -185,7 +186,7 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   if (now_ns() && r.stamp_ns > *now_ns() + s_to_ns(params_.epoch_window_s)) {
     return InputResult::rejected(Rejection::kAheadOfOdometry);
   }
-  if (auto last = last_range_.find(r.beacon_id); last != last_range_.end() && last->second.first == r.stamp_ns) {
+  if (auto last = last_range_.find(r.beacon_id); last != last_range_.end() && last->second.newest_ns == r.stamp_ns) {
     return InputResult::rejected(Rejection::kDuplicateRange);
   }
 
@@ -210,13 +211,43 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   if (epoch.ranges.size() >= kMaxEpochRanges) return InputResult::rejected(Rejection::kTooManyRangesInEpoch);
   record(r);
   std::optional<double> rate_mps;
+  bool an_echo = false;  // longer than the beacon's previous range allows
   if (auto last = last_range_.find(r.beacon_id); last != last_range_.end()) {
-    const StampNs dt_ns = r.stamp_ns - last->second.first;
-    // A range cannot change faster than the robot moves: a faster "rate" is an echo's.
-    if (dt_ns > 0 && dt_ns <= kRangeRateWindowNs) rate_mps = (r.range_m - last->second.second) / ns_to_s(dt_ns);
-    if (rate_mps && !(std::abs(*rate_mps) <= kMaxWheelSpeedMps)) rate_mps.reset();
+    const LastRange& before = last->second;
+    const StampNs dt_ns = r.stamp_ns - before.stamp_ns;
+    // A range cannot change by more than the receiver moved (the odometry's displacement, 5 % of
+    // it for the odometry's error, and 4 sigma of the two ranges): a larger change is an echo's
+    // (its extra path is 0.3 m or more), and its "rate" would move the range wrongly. An echo is
+    // longer than the direct path: this range, when it grew too much (kept out of the rates, the
+    // previous one stays the reference); the previous, when it shrank too much.
+    // Time between the two the odometry did not integrate (a gap, or before its first sample):
+    // the receiver may have moved as fast as any robot then.
+    const Eigen::Vector2d& rx = receivers_.receivers_base_m[0];
+    const double moved_m = (transform_point(odometry_pose_, rx) - transform_point(before.odometry_pose, rx)).norm();
+    const StampNs unseen_ns = dt_ns - (odometry_integrated_ns_ - before.integrated_ns);
+    const double unseen_m = unseen_ns > s_to_ns(params_.epoch_window_s) ? kMaxWheelSpeedMps * ns_to_s(unseen_ns) : 0.0;
+    const double allowed_m = 1.05 * moved_m + unseen_m + 4.0 * std::sqrt(r.variance_m2 + before.variance_m2);
+    if (dt_ns > 0 && dt_ns <= kRangeRateWindowNs) {
+      if (std::abs(r.range_m - before.range_m) <= allowed_m) {
+        rate_mps = (r.range_m - before.range_m) / ns_to_s(dt_ns);
+      } else {
+        an_echo = r.range_m > before.range_m;
+      }
+    }
   }
-  last_range_[r.beacon_id] = {r.stamp_ns, r.range_m};
+  const auto last = last_range_.find(r.beacon_id);
+  const bool first = last == last_range_.end();
+  LastRange& ref = first ? last_range_[r.beacon_id] : last->second;
+  // Newer than the reference, not an echo: the next range's predecessor (an older one, pushed
+  // out of order, is not).
+  if (first || (!an_echo && r.stamp_ns > ref.stamp_ns)) {
+    ref.stamp_ns = r.stamp_ns;
+    ref.range_m = r.range_m;
+    ref.variance_m2 = r.variance_m2;
+    ref.odometry_pose = odometry_pose_;
+    ref.integrated_ns = odometry_integrated_ns_;
+  }
+  ref.newest_ns = std::max(first ? r.stamp_ns : ref.newest_ns, r.stamp_ns);
   epoch.ranges.push_back({r.beacon_id, r.range_m, r.variance_m2, odometry_pose_, r.stamp_ns, rate_mps});
 
   if (params_.geometry == Geometry::kHyperbolic) return InputResult::ok();  // fused with its epoch

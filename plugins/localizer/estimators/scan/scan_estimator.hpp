@@ -25,7 +25,12 @@
 //    fix from ranges taken along 3 cm of travel is biased across the track at a group's edge
 //    (10 cm on seed 003: the ranges to the beacons that fire later are shorter). A fix is made of
 //    the ranges brought to the epoch's last instant by each beacon's range rate since its
-//    previous range (one group cycle before); a range without a recent predecessor waits.
+//    previous range (one group cycle before); a range without a recent predecessor waits. A
+//    range that changed by more than the receiver moved since (odometry) has no rate: an echo is
+//    in one of the two, and an echo is the longer; a range longer than that is not the next
+//    one's predecessor either.
+//  - a vector of the analytic average whose scale is off 1 by more than 10 % is left out of it
+//    (similarity_transform.hpp: the frames are in metres; one wrong pair spoils the mean).
 //  - the inverse trajectory (Sec. 3.6, inverse_trajectory.hpp): the inputs since the robot last
 //    left a GRULPS are kept; once it has been back in a GRULPS's coverage (any, the same one
 //    after a loop too) for inverse_after_s, with groups calibrated on the way, the drive is run
@@ -199,13 +204,22 @@ class ScanEstimator final : public EstimatorBase {
   ScanParameters params_;
   StartupWait waiting_for_;
   Pose2 odometry_pose_ = Pose2::Zero();
+  StampNs odometry_integrated_ns_ = 0;  // the time the odometry integrated so far (gaps not)
   Frame global_;
   std::map<std::uint32_t, LocalGroup> local_;           // by group, the LRULPSs not calibrated yet
   std::map<std::uint32_t, CalibratedBeacon> calibrated_;  // by beacon id
   BeaconCalibration calibration_;
   bool calibration_changed_ = false;  // since take_calibration_update last asked
   std::map<std::uint32_t, Epoch> open_epochs_;  // by group
-  std::map<std::uint32_t, std::pair<StampNs, double>> last_range_;  // by beacon: its previous range's stamp, range
+  struct LastRange {  // a beacon's previous range that was not an echo, for its range rate
+    StampNs newest_ns = 0;  // the stamp of its newest range, echo or not (a duplicate is refused)
+    StampNs stamp_ns = 0;
+    double range_m = 0.0;
+    double variance_m2 = 0.0;
+    Pose2 odometry_pose = Pose2::Zero();  // the dead-reckoned pose when it came
+    StampNs integrated_ns = 0;            // odometry_integrated_ns_ then
+  };
+  std::map<std::uint32_t, LastRange> last_range_;  // by beacon
   // Sec. 3.6: the inputs since the robot last left a GRULPS, and when it came back to one.
   InputLog<RecordedInput> log_;
   bool log_full_ = false;

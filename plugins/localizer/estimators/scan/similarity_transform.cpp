@@ -62,6 +62,7 @@ const char* to_string(TransformFailure failure) {
     case TransformFailure::kPointsTooClose: return "points_too_close";
     case TransformFailure::kSingular: return "singular";
     case TransformFailure::kNonFinite: return "non_finite";
+    case TransformFailure::kImplausibleScale: return "implausible_scale";
   }
   return "unknown";
 }
@@ -138,7 +139,9 @@ TransformFailure AnalyticAverage::add(const PointPair& pair) {
     if ((it->local_m - pair.local_m).norm() < min_separation_m_) continue;
     const TransformFit fit = analytic_similarity(pair, *it, min_separation_m_);
     outcome = fit.failure;
-    if (fit.transform) {
+    if (fit.transform && !(std::abs(fit.transform->scale() - 1.0) <= kMaxVectorScaleError)) {
+      outcome = TransformFailure::kImplausibleScale;
+    } else if (fit.transform) {
       sum_ += fit.transform->t_c;
       ++count_;
     }

@@ -307,6 +307,15 @@ std::optional<std::vector<std::uint32_t>> UkfLrf::associate(const std::vector<Ra
   return out;
 }
 
+EstimatorBase::PoseBelief UkfLrf::pose_belief() const {
+  PoseBelief belief{filter_.state(), filter_.covariance()};
+  if (grid_ && mode_ != Mode::kBeaconsOnly) {
+    const double r = grid_->resolution_m();
+    belief.covariance.topLeftCorner<2, 2>() += (r * r / 12.0) * Eigen::Matrix2d::Identity();
+  }
+  return belief;
+}
+
 std::vector<Estimator::StateValue> UkfLrf::state_values() const {
   return {{"beams_gated", static_cast<double>(beams_gated_), 0.0}};
 }

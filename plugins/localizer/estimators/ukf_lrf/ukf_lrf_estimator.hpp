@@ -65,7 +65,11 @@ class UkfLrf final : public EstimatorBase {
 
  private:
   UkfLrf(const EstimatorConfig& config, Mode mode, const UkfLrfParameters& params);
-  PoseBelief pose_belief() const override { return {filter_.state(), filter_.covariance()}; }
+  // The filter's belief, its position covariance given the map's own error where the laser
+  // places the robot: the grid cannot place a face better than within its cell, an error every
+  // beam and every scan share, which the filter (eq. 7: each beam's noise its own) does not hold
+  // (a uniform error over a cell, r^2 / 12 per axis).
+  PoseBelief pose_belief() const override;
   // Placed by hand (Sec. 4.1): until then it waits for that, whatever else it has.
   StartupWait waiting_for() const override { return {StartupCondition::kNeedsInitialPose, 0.0, 0.0, {}}; }
   bool needs_beacon_map() const override { return false; }

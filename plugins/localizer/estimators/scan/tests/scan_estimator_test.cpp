@@ -59,6 +59,49 @@ TEST(ScanEstimator, StartsFromTwoFixesOfTheFirstGroupOnceTheRobotHasMoved) {
   EXPECT_EQ(scan.status(), PoseStatus::kOk);
 }
 
+// An echo (a range 1 m long) on every other range of one of GRULPS 1's five beacons: each echo
+// is left out of its epoch's fix (no range rate: it grew more than the robot moved) and is not
+// the next range's predecessor, so every fix stands on the other four and the robot starts
+// exactly when it does without them. (Given a rate, an echo spoiled its epoch's fix and, through
+// the next range's rate, the next one's.) The echo's stamp is still a duplicate when repeated.
+TEST(ScanEstimator, AnEchoSpoilsNeitherItsEpochsFixNorTheNextOnes) {
+  const sim::Scenario s = seed003();
+  const auto first_pose_ns = [&](const std::vector<EstimatorInput>& in) -> std::optional<StampNs> {
+    ScanEstimator scan(config_of(s));
+    scan.set_beacon_map(BeaconMap(s.beacon_list()));
+    for (const EstimatorInput& i : in) {
+      scan.push(i);
+      if (scan.estimate()) return stamp_of(i);
+    }
+    return std::nullopt;
+  };
+  const std::vector<EstimatorInput> clean = inputs(s, 8.0);
+  std::vector<EstimatorInput> echoed = clean;
+  int heard = 0;
+  std::optional<RangeMeasurement> an_echo;
+  for (EstimatorInput& i : echoed) {
+    auto* r = std::get_if<RangeMeasurement>(&i);
+    if (r && r->beacon_id == 11 && heard++ % 2 == 1) {
+      r->range_m += 1.0;
+      if (!an_echo) an_echo = *r;
+    }
+  }
+  ASSERT_GE(heard, 6);
+  const std::optional<StampNs> started = first_pose_ns(clean);
+  ASSERT_TRUE(started);
+  EXPECT_EQ(first_pose_ns(echoed), started);
+  ScanEstimator scan(config_of(s));
+  scan.set_beacon_map(BeaconMap(s.beacon_list()));
+  for (const EstimatorInput& i : echoed) {
+    scan.push(i);
+    if (std::holds_alternative<RangeMeasurement>(i) && std::get<RangeMeasurement>(i).stamp_ns == an_echo->stamp_ns &&
+        std::get<RangeMeasurement>(i).beacon_id == 11) {
+      break;
+    }
+  }
+  EXPECT_EQ(scan.update(*an_echo).rejection, Rejection::kDuplicateRange);
+}
+
 // Before a group is calibrated its ranges reach only its own frame: the map pose is the same as
 // with those ranges left out. (With them fused as if known, at their local coordinates, the pose
 // would jump by the group's offset, metres.)

@@ -82,6 +82,19 @@ TEST(SimilarityTransform, TheAverageOverTheOverlapIsCloserThanOnePair) {
   EXPECT_LT(beacon_error_m(*mean.transform), beacon_error_m(*one.transform));
 }
 
+TEST(SimilarityTransform, TheAverageLeavesOutAVectorWhoseScaleNoFrameInMetresHas) {
+  AnalyticAverage average(2.5);
+  EXPECT_EQ(average.add(pair_at({0.0, 0.0})), TransformFailure::kTooFewPoints);
+  EXPECT_EQ(average.add(pair_at({3.0, 0.0})), TransformFailure::kNone);  // scale 1.02
+  // A pair whose global point is 1 m off (a fix an echo moved): its vector's scale is 1.35.
+  PointPair wrong = pair_at({6.0, 0.0});
+  wrong.global_m += Eigen::Vector2d(std::cos(0.7), std::sin(0.7));
+  EXPECT_EQ(average.add(wrong), TransformFailure::kImplausibleScale);
+  EXPECT_EQ(average.count(), 1u);
+  EXPECT_TRUE(average.average().transform->t_c.isApprox(truth().t_c, 1e-9));
+  EXPECT_STREQ(to_string(TransformFailure::kImplausibleScale), "implausible_scale");
+}
+
 TEST(SimilarityTransform, TheNumericalFitRecoversAnExactTransformAndSpreadsItsPoints) {
   std::vector<PointPair> track;
   for (int k = 0; k <= 500; ++k) track.push_back(pair_at({-2.5 + 0.01 * k, 0.3 + 0.002 * k}));
