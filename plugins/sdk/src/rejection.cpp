@@ -46,6 +46,7 @@ const char* to_string(Rejection r) {
     case Rejection::kAheadOfOdometry: return "ahead_of_odometry";
     case Rejection::kGatedNis: return "gated_nis";
     case Rejection::kEchoOfFiring: return "echo_of_firing";
+    case Rejection::kLongerThanTheReceiverMoved: return "longer_than_the_receiver_moved";
     case Rejection::kSingularInnovation: return "singular_innovation";
     case Rejection::kCovarianceNotPositiveDefinite: return "covariance_not_positive_definite";
     case Rejection::kHInfinityBoundNotMet: return "h_infinity_bound_not_met";

@@ -190,26 +190,6 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
     return InputResult::rejected(Rejection::kDuplicateRange);
   }
 
-  // Every good range joins its group's epoch (the fixes and the hyperbolic updates are made of them).
-  const std::uint32_t group = known ? known->group : local->group;
-  // A frame's correction is stamped with the range (up to an odometry period after the newest
-  // odometry), so that an epoch's first range counts as inside it.
-  const StampNs now = std::max(now_ns().value_or(r.stamp_ns), r.stamp_ns);
-  auto open = open_epochs_.find(group);
-  if (open != open_epochs_.end()) {
-    const Epoch& e = open->second;
-    const bool repeated = std::any_of(e.ranges.begin(), e.ranges.end(),
-                                      [&](const EpochEntry& x) { return x.beacon_id == r.beacon_id; });
-    if (repeated || r.stamp_ns - e.ranges.front().stamp_ns > s_to_ns(params_.epoch_window_s)) {
-      const Epoch done = e;
-      open_epochs_.erase(open);
-      process_epoch(done);
-    }
-  }
-  Epoch& epoch = open_epochs_[group];
-  epoch.group = group;
-  if (epoch.ranges.size() >= kMaxEpochRanges) return InputResult::rejected(Rejection::kTooManyRangesInEpoch);
-  record(r);
   std::optional<double> rate_mps;
   bool an_echo = false;  // longer than the beacon's previous range allows
   if (auto last = last_range_.find(r.beacon_id); last != last_range_.end()) {
@@ -235,19 +215,45 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
       }
     }
   }
-  const auto last = last_range_.find(r.beacon_id);
-  const bool first = last == last_range_.end();
-  LastRange& ref = first ? last_range_[r.beacon_id] : last->second;
-  // Newer than the reference, not an echo: the next range's predecessor (an older one, pushed
+  // Longer than its beacon's previous range by more than the receiver moved: an echo, in no
+  // epoch, no fix and no filter (a filter's gate alone lets it through a calibrated beacon's wide
+  // variance), and not the next range's predecessor; its stamp is kept for the duplicate check.
+  if (an_echo) {
+    last_range_[r.beacon_id].newest_ns = std::max(last_range_[r.beacon_id].newest_ns, r.stamp_ns);
+    return InputResult::rejected(Rejection::kLongerThanTheReceiverMoved);
+  }
+
+  // Every good range joins its group's epoch (the fixes and the hyperbolic updates are made of them).
+  const std::uint32_t group = known ? known->group : local->group;
+  // A frame's correction is stamped with the range (up to an odometry period after the newest
+  // odometry), so that an epoch's first range counts as inside it.
+  const StampNs now = std::max(now_ns().value_or(r.stamp_ns), r.stamp_ns);
+  auto open = open_epochs_.find(group);
+  if (open != open_epochs_.end()) {
+    const Epoch& e = open->second;
+    const bool repeated = std::any_of(e.ranges.begin(), e.ranges.end(),
+                                      [&](const EpochEntry& x) { return x.beacon_id == r.beacon_id; });
+    if (repeated || r.stamp_ns - e.ranges.front().stamp_ns > s_to_ns(params_.epoch_window_s)) {
+      const Epoch done = e;
+      open_epochs_.erase(open);
+      process_epoch(done);
+    }
+  }
+  Epoch& epoch = open_epochs_[group];
+  epoch.group = group;
+  if (epoch.ranges.size() >= kMaxEpochRanges) return InputResult::rejected(Rejection::kTooManyRangesInEpoch);
+  record(r);
+  // The next range's predecessor: this one, when newer than the reference (an older one, pushed
   // out of order, is not).
-  if (first || (!an_echo && r.stamp_ns > ref.stamp_ns)) {
+  LastRange& ref = last_range_[r.beacon_id];
+  if (r.stamp_ns > ref.stamp_ns || ref.newest_ns == 0) {
     ref.stamp_ns = r.stamp_ns;
     ref.range_m = r.range_m;
     ref.variance_m2 = r.variance_m2;
     ref.odometry_pose = odometry_pose_;
     ref.integrated_ns = odometry_integrated_ns_;
   }
-  ref.newest_ns = std::max(first ? r.stamp_ns : ref.newest_ns, r.stamp_ns);
+  ref.newest_ns = std::max(ref.newest_ns, r.stamp_ns);
   epoch.ranges.push_back({r.beacon_id, r.range_m, r.variance_m2, odometry_pose_, r.stamp_ns, rate_mps});
 
   if (params_.geometry == Geometry::kHyperbolic) return InputResult::ok();  // fused with its epoch

@@ -61,6 +61,7 @@ enum class Rejection : std::uint8_t {
   // A filter's update or prediction not applied (core/filters/outcome.hpp).
   kGatedNis,
   kEchoOfFiring,  // longer than another receiver's range of the same firing allows (ranges_of_one_firing_agree)
+  kLongerThanTheReceiverMoved,  // longer than its beacon's previous range by more than the receiver moved since (an echo)
   kSingularInnovation,
   kCovarianceNotPositiveDefinite,
   kHInfinityBoundNotMet,
