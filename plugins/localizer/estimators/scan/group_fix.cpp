@@ -3,6 +3,8 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <optional>
 
 #include "beaconloc/core/chi_square.hpp"
 
@@ -118,6 +120,44 @@ GroupFix solve_group_fix(const GroupMeasurements& m, const GroupFixSettings& set
     }
   }
   return failed(GroupFixFailure::kNotConverged, settings.max_iterations);
+}
+
+GroupFixWithoutAnEcho solve_group_fix_without_an_echo(const GroupMeasurements& m, const GroupFixSettings& settings) {
+  GroupFixWithoutAnEcho out{solve_group_fix(m, settings), -1};
+  const bool spoiled = out.fix.failure == GroupFixFailure::kResidualTooLarge ||
+                       out.fix.failure == GroupFixFailure::kNotConverged;
+  const std::size_t needed = m.geometry == Geometry::kSpherical ? 3 : 4;
+  if (!spoiled || m.ranges_m.size() != m.beacons_m.size() || m.ranges_m.size() < needed + 1) return out;
+  const double variance = m.range_sigma_m * m.range_sigma_m;
+  std::optional<GroupFixWithoutAnEcho> found;
+  for (std::size_t skip = 0; skip < m.ranges_m.size(); ++skip) {
+    GroupMeasurements subset = m;
+    subset.beacons_m.erase(subset.beacons_m.begin() + static_cast<std::ptrdiff_t>(skip));
+    subset.ranges_m.erase(subset.ranges_m.begin() + static_cast<std::ptrdiff_t>(skip));
+    const GroupFix fix = solve_group_fix(subset, settings);
+    if (!fix.ok()) continue;
+    // The left-out range against the one the subset's fix predicts (hyperbolic: both taken from
+    // the subset's reference, its first beacon), in sigmas of the measurement and the fix.
+    const Vec<3> pose(fix.position_m.x(), fix.position_m.y(), 0.0);
+    const auto predicted = [&](const Eigen::Vector3d& beacon) {
+      return RangeModel(Eigen::Vector2d::Zero(), m.receiver_z_m, beacon, variance).linearize(pose);
+    };
+    const auto left = predicted(m.beacons_m[skip]);
+    double excess_m = m.ranges_m[skip] - left.predicted(0);
+    Eigen::RowVector2d jacobian = left.jacobian.leftCols<2>();
+    double measurement_variance = variance;
+    if (m.geometry == Geometry::kHyperbolic) {
+      const auto reference = predicted(subset.beacons_m.front());
+      excess_m -= subset.ranges_m.front() - reference.predicted(0);
+      jacobian -= reference.jacobian.leftCols<2>();
+      measurement_variance = 2.0 * variance;
+    }
+    const double sigma_m = std::sqrt(measurement_variance + jacobian * fix.covariance_m2 * jacobian.transpose());
+    if (!(excess_m > kEchoExcessSigma * sigma_m)) continue;
+    if (found) return out;  // two candidates: the echo is not known
+    found = GroupFixWithoutAnEcho{fix, static_cast<int>(skip)};
+  }
+  return found ? *found : out;
 }
 
 }  // namespace beaconloc::scan

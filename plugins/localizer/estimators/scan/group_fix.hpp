@@ -49,4 +49,19 @@ struct GroupFix {
 // Starts under the group's centroid (the robot hears the group: it is within its coverage).
 GroupFix solve_group_fix(const GroupMeasurements& m, const GroupFixSettings& settings = {});
 
+// Not in the paper: an echo (a reflection's longer path) spoils one range of an epoch, and the fix
+// of them all fails. With a range more than a checked fix needs (four ranges spherical, five
+// beacons hyperbolic), each is left out in turn: the fix is that of the one subset whose own fix
+// passes its gate and predicts the range it left out shorter than measured by more than
+// kEchoExcessSigma of that range (an echo is only ever longer). When no subset, or more than one,
+// does so, the fix of them all stands (with its failure): which range is the echo is not known.
+// left_out is the range left out, or -1.
+inline constexpr double kEchoExcessSigma = 3.0;
+struct GroupFixWithoutAnEcho {
+  GroupFix fix;
+  int left_out = -1;
+};
+GroupFixWithoutAnEcho solve_group_fix_without_an_echo(const GroupMeasurements& m,
+                                                      const GroupFixSettings& settings = {});
+
 }  // namespace beaconloc::scan

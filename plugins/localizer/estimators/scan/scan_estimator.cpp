@@ -17,7 +17,7 @@ namespace {
 
 // A beacon's range rate is taken from its previous range when that is at most this old (two of
 // seed003_scan.yaml's 0.76 s cycles, with one missed).
-constexpr StampNs kRangeRateWindowNs = 2 * kNsPerSecond;
+constexpr StampNs kRangeRateWindowNs = 3 * kNsPerSecond;
 // More ranges in one group's epoch than any ULPS has beacons (the paper's have 4-5): a flood,
 // refused before a Gauss-Newton fix over them costs O(n^3) per iteration.
 constexpr std::size_t kMaxEpochRanges = 64;
@@ -172,6 +172,22 @@ InputResult ScanEstimator::predict(const OdometrySample& o) {
   return InputResult::ok();
 }
 
+ScanEstimator::Compared ScanEstimator::compare(const RangeMeasurement& r, const RangeSample& before) const {
+  const StampNs dt_ns = r.stamp_ns - before.stamp_ns;
+  if (dt_ns <= 0 || dt_ns > kRangeRateWindowNs) return {};
+  // What the receiver moved: the odometry's displacement, 5 % of it for the odometry's error, and
+  // 4 sigma of the two ranges. Time between the two the odometry did not integrate (a gap, or
+  // before its first sample): the receiver may have moved as fast as any robot then.
+  const Eigen::Vector2d& rx = receivers_.receivers_base_m[0];
+  const double moved_m = (transform_point(odometry_pose_, rx) - transform_point(before.odometry_pose, rx)).norm();
+  const StampNs unseen_ns = dt_ns - (odometry_integrated_ns_ - before.integrated_ns);
+  const double unseen_m = unseen_ns > s_to_ns(params_.epoch_window_s) ? kMaxWheelSpeedMps * ns_to_s(unseen_ns) : 0.0;
+  const double allowed_m = 1.05 * moved_m + unseen_m + 4.0 * std::sqrt(r.variance_m2 + before.variance_m2);
+  const double change_m = r.range_m - before.range_m;
+  if (std::abs(change_m) <= allowed_m) return {RangeChange::kWithinMotion, change_m / ns_to_s(dt_ns)};
+  return {change_m > 0.0 ? RangeChange::kLonger : RangeChange::kShorter, 0.0};
+}
+
 InputResult ScanEstimator::update(const RangeMeasurement& r) {
   if (InputResult numbers = check_range_numbers(r); !numbers.accepted) return numbers;
   if (r.beacon_id == kBeaconUnidentified) return InputResult::rejected(Rejection::kUnassociatedRange);
@@ -190,29 +206,22 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
     return InputResult::rejected(Rejection::kDuplicateRange);
   }
 
+  // A range cannot change by more than the receiver moved (compare): a larger change is an
+  // echo's (its extra path is 0.3 m or more), and its "rate" would move the range wrongly. An
+  // echo is longer than the direct path: this range, when it grew too much (kept out of the
+  // rates, the previous one stays the reference); the previous, when it shrank too much, and
+  // then the rate is taken from the one before that, when it is within the motion.
   std::optional<double> rate_mps;
-  bool an_echo = false;  // longer than the beacon's previous range allows
+  bool an_echo = false;          // longer than the beacon's previous range allows
+  bool after_an_echo = false;    // shorter: the previous range was an echo
   if (auto last = last_range_.find(r.beacon_id); last != last_range_.end()) {
-    const LastRange& before = last->second;
-    const StampNs dt_ns = r.stamp_ns - before.stamp_ns;
-    // A range cannot change by more than the receiver moved (the odometry's displacement, 5 % of
-    // it for the odometry's error, and 4 sigma of the two ranges): a larger change is an echo's
-    // (its extra path is 0.3 m or more), and its "rate" would move the range wrongly. An echo is
-    // longer than the direct path: this range, when it grew too much (kept out of the rates, the
-    // previous one stays the reference); the previous, when it shrank too much.
-    // Time between the two the odometry did not integrate (a gap, or before its first sample):
-    // the receiver may have moved as fast as any robot then.
-    const Eigen::Vector2d& rx = receivers_.receivers_base_m[0];
-    const double moved_m = (transform_point(odometry_pose_, rx) - transform_point(before.odometry_pose, rx)).norm();
-    const StampNs unseen_ns = dt_ns - (odometry_integrated_ns_ - before.integrated_ns);
-    const double unseen_m = unseen_ns > s_to_ns(params_.epoch_window_s) ? kMaxWheelSpeedMps * ns_to_s(unseen_ns) : 0.0;
-    const double allowed_m = 1.05 * moved_m + unseen_m + 4.0 * std::sqrt(r.variance_m2 + before.variance_m2);
-    if (dt_ns > 0 && dt_ns <= kRangeRateWindowNs) {
-      if (std::abs(r.range_m - before.range_m) <= allowed_m) {
-        rate_mps = (r.range_m - before.range_m) / ns_to_s(dt_ns);
-      } else {
-        an_echo = r.range_m > before.range_m;
-      }
+    const Compared latest = compare(r, last->second.latest);
+    an_echo = latest.change == RangeChange::kLonger;
+    after_an_echo = latest.change == RangeChange::kShorter;
+    if (latest.change == RangeChange::kWithinMotion) rate_mps = latest.rate_mps;
+    if (after_an_echo && last->second.before) {
+      const Compared before = compare(r, *last->second.before);
+      if (before.change == RangeChange::kWithinMotion) rate_mps = before.rate_mps;
     }
   }
   // Longer than its beacon's previous range by more than the receiver moved: an echo, in no
@@ -246,12 +255,9 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   // The next range's predecessor: this one, when newer than the reference (an older one, pushed
   // out of order, is not).
   LastRange& ref = last_range_[r.beacon_id];
-  if (r.stamp_ns > ref.stamp_ns || ref.newest_ns == 0) {
-    ref.stamp_ns = r.stamp_ns;
-    ref.range_m = r.range_m;
-    ref.variance_m2 = r.variance_m2;
-    ref.odometry_pose = odometry_pose_;
-    ref.integrated_ns = odometry_integrated_ns_;
+  if (r.stamp_ns > ref.latest.stamp_ns || ref.newest_ns == 0) {
+    if (ref.newest_ns != 0 && !after_an_echo) ref.before = ref.latest;  // an echo is no one's predecessor
+    ref.latest = {r.stamp_ns, r.range_m, r.variance_m2, odometry_pose_, odometry_integrated_ns_};
   }
   ref.newest_ns = std::max(ref.newest_ns, r.stamp_ns);
   epoch.ranges.push_back({r.beacon_id, r.range_m, r.variance_m2, odometry_pose_, r.stamp_ns, rate_mps});
@@ -372,7 +378,7 @@ std::optional<GroupFix> ScanEstimator::fix_of(const Epoch& epoch, bool global) {
     return std::nullopt;
   }
   m.range_sigma_m = std::sqrt(variance_sum / static_cast<double>(m.ranges_m.size()));
-  const GroupFix fix = solve_group_fix(m);
+  const GroupFix fix = solve_group_fix_without_an_echo(m).fix;
   if (!fix.ok()) {
     if (first_pose) waiting_for_ = {StartupCondition::kFixFailed, 0.0, 0.0, to_string(fix.failure)};
     return std::nullopt;

@@ -4,6 +4,7 @@
 
 #include <Eigen/LU>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 
@@ -94,6 +95,60 @@ TEST(GroupFix, TooFewBadOrContradictoryMeasurementsAreRefusedByReason) {
     hyperbolic.ranges_m[2] += extra_m;
     EXPECT_EQ(solve_group_fix(hyperbolic).failure, GroupFixFailure::kResidualTooLarge) << extra_m;
   }
+}
+
+// An echo on one range of an epoch with a range to spare (four spherical, five hyperbolic): the
+// fix of them all fails, and the fix leaving it out is found, whichever range it is (spherical;
+// hyperbolic, where it is found, the reference too, and never a wrong one). Not found where it
+// cannot be told: three spherical ranges, two echoes, or a range shorter than the others say
+// (an echo is only ever longer).
+TEST(GroupFix, AnEchoOnARangeToSpareIsLeftOutAndNothingElseIs) {
+  const Eigen::Vector2d robot(1.5, -0.8);
+  for (const Geometry g : {Geometry::kSpherical, Geometry::kHyperbolic}) {
+    GroupMeasurements clean = measured(g, robot, 0.005);
+    if (g == Geometry::kHyperbolic) {  // a fifth beacon at the square's centre
+      clean.beacons_m.emplace_back(0.0, 0.0, 3.5);
+      clean.ranges_m.push_back((Eigen::Vector3d(robot.x(), robot.y(), 0.0) - clean.beacons_m.back()).norm());
+    }
+    const GroupFixWithoutAnEcho unspoiled = solve_group_fix_without_an_echo(clean);
+    EXPECT_TRUE(unspoiled.fix.ok());
+    EXPECT_EQ(unspoiled.left_out, -1);
+    int found = 0;
+    for (std::size_t k = 0; k < clean.ranges_m.size(); ++k) {
+      for (const double extra_m : {0.3, 1.0}) {
+        GroupMeasurements echoed = clean;
+        echoed.ranges_m[k] += extra_m;
+        ASSERT_FALSE(solve_group_fix(echoed).ok());
+        const GroupFixWithoutAnEcho f = solve_group_fix_without_an_echo(echoed);
+        // Three differences of four beacons leave one degree of freedom, and a wrong subset can
+        // fit as well as the right one: then no fix, never the wrong one.
+        found += f.fix.ok();
+        if (g == Geometry::kSpherical) {
+          ASSERT_TRUE(f.fix.ok()) << "range " << k << " extra " << extra_m << ": " << to_string(f.fix.failure);
+        }
+        if (f.fix.ok()) {
+          EXPECT_EQ(f.left_out, static_cast<int>(k));
+          EXPECT_LT((f.fix.position_m - robot).norm(), 1e-6);
+        }
+        GroupMeasurements shorter = clean;
+        shorter.ranges_m[k] -= extra_m;
+        EXPECT_FALSE(solve_group_fix_without_an_echo(shorter).fix.ok()) << "range " << k << " shorter";
+        GroupMeasurements two = echoed;
+        two.ranges_m[(k + 1) % two.ranges_m.size()] += 0.7;
+        EXPECT_FALSE(solve_group_fix_without_an_echo(two).fix.ok()) << "ranges " << k << " and the next";
+      }
+    }
+    std::printf("%s: %d of %zu echoes left out\n", g == Geometry::kSpherical ? "spherical" : "hyperbolic", found,
+                2 * clean.ranges_m.size());
+    EXPECT_GT(found, 0);
+  }
+  GroupMeasurements three = measured(Geometry::kSpherical, robot, 0.005);
+  three.beacons_m.pop_back();
+  three.ranges_m.pop_back();
+  three.ranges_m[0] += 0.5;
+  const GroupFixWithoutAnEcho f = solve_group_fix_without_an_echo(three);
+  EXPECT_FALSE(f.fix.ok());
+  EXPECT_EQ(f.left_out, -1);
 }
 
 }  // namespace
