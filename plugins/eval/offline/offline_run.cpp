@@ -210,6 +210,13 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
     }
   }
   result.poses = rows.size();
+  if (!rows.empty()) {
+    const PoseEstimate& last = rows.back().estimate;
+    result.last_status = last.status;
+    if (const auto at = truth.at(last.stamp_ns)) {
+      result.last_position_error_m = (last.pose_map_base.head<2>() - at->pose_map_base.head<2>()).norm();
+    }
+  }
   result.associations = stack.associations;
   result.rejections.add_rejections(stack.decoder.counts(), "decoder.");
   result.rejections.add_rejections(stack.localizer.counts(), "localizer.");

@@ -67,13 +67,15 @@ const char* to_string(GroupFixFailure failure) {
     case GroupFixFailure::kSingular: return "singular";
     case GroupFixFailure::kNotConverged: return "not_converged";
     case GroupFixFailure::kResidualTooLarge: return "residual_too_large";
+    case GroupFixFailure::kEchoUnidentified: return "echo_unidentified";
   }
   return "unknown";
 }
 
+std::size_t ranges_for_a_fix(Geometry g) { return g == Geometry::kSpherical ? 3 : 4; }
+
 GroupFix solve_group_fix(const GroupMeasurements& m, const GroupFixSettings& settings) {
-  const std::size_t needed = m.geometry == Geometry::kSpherical ? 3 : 4;
-  if (m.beacons_m.size() != m.ranges_m.size() || m.beacons_m.size() < needed) {
+  if (m.beacons_m.size() != m.ranges_m.size() || m.beacons_m.size() < ranges_for_a_fix(m.geometry)) {
     return failed(GroupFixFailure::kTooFewBeacons);
   }
   Eigen::Vector2d p = Eigen::Vector2d::Zero();
@@ -123,12 +125,15 @@ GroupFix solve_group_fix(const GroupMeasurements& m, const GroupFixSettings& set
 }
 
 GroupFixWithoutAnEcho solve_group_fix_without_an_echo(const GroupMeasurements& m, const GroupFixSettings& settings) {
-  GroupFixWithoutAnEcho out{solve_group_fix(m, settings), -1};
+  GroupFixWithoutAnEcho out{solve_group_fix(m, settings), std::nullopt};
   const bool spoiled = out.fix.failure == GroupFixFailure::kResidualTooLarge ||
-                       out.fix.failure == GroupFixFailure::kNotConverged;
-  const std::size_t needed = m.geometry == Geometry::kSpherical ? 3 : 4;
-  if (!spoiled || m.ranges_m.size() != m.beacons_m.size() || m.ranges_m.size() < needed + 1) return out;
-  const double variance = m.range_sigma_m * m.range_sigma_m;
+                       out.fix.failure == GroupFixFailure::kNotConverged ||
+                       out.fix.failure == GroupFixFailure::kSingular;
+  if (!spoiled || m.geometry != Geometry::kSpherical || m.ranges_m.size() != m.beacons_m.size() ||
+      m.ranges_m.size() < ranges_for_a_fix(m.geometry) + 1) {
+    return out;
+  }
+  const double variance_m2 = m.range_sigma_m * m.range_sigma_m;
   std::optional<GroupFixWithoutAnEcho> found;
   for (std::size_t skip = 0; skip < m.ranges_m.size(); ++skip) {
     GroupMeasurements subset = m;
@@ -136,26 +141,19 @@ GroupFixWithoutAnEcho solve_group_fix_without_an_echo(const GroupMeasurements& m
     subset.ranges_m.erase(subset.ranges_m.begin() + static_cast<std::ptrdiff_t>(skip));
     const GroupFix fix = solve_group_fix(subset, settings);
     if (!fix.ok()) continue;
-    // The left-out range against the one the subset's fix predicts (hyperbolic: both taken from
-    // the subset's reference, its first beacon), in sigmas of the measurement and the fix.
-    const Vec<3> pose(fix.position_m.x(), fix.position_m.y(), 0.0);
-    const auto predicted = [&](const Eigen::Vector3d& beacon) {
-      return RangeModel(Eigen::Vector2d::Zero(), m.receiver_z_m, beacon, variance).linearize(pose);
-    };
-    const auto left = predicted(m.beacons_m[skip]);
-    double excess_m = m.ranges_m[skip] - left.predicted(0);
-    Eigen::RowVector2d jacobian = left.jacobian.leftCols<2>();
-    double measurement_variance = variance;
-    if (m.geometry == Geometry::kHyperbolic) {
-      const auto reference = predicted(subset.beacons_m.front());
-      excess_m -= subset.ranges_m.front() - reference.predicted(0);
-      jacobian -= reference.jacobian.leftCols<2>();
-      measurement_variance = 2.0 * variance;
-    }
-    const double sigma_m = std::sqrt(measurement_variance + jacobian * fix.covariance_m2 * jacobian.transpose());
+    // The left-out range against the one the subset's fix predicts, in sigmas of the range and of
+    // the prediction (the fix is made of the other ranges: the two are independent).
+    const auto left = RangeModel(Eigen::Vector2d::Zero(), m.receiver_z_m, m.beacons_m[skip], variance_m2)
+                          .linearize(Vec<3>(fix.position_m.x(), fix.position_m.y(), 0.0));
+    const Eigen::RowVector2d jacobian = left.jacobian.leftCols<2>();
+    const double excess_m = m.ranges_m[skip] - left.predicted(0);
+    const double sigma_m = std::sqrt(variance_m2 + jacobian * fix.covariance_m2 * jacobian.transpose());
     if (!(excess_m > kEchoExcessSigma * sigma_m)) continue;
-    if (found) return out;  // two candidates: the echo is not known
-    found = GroupFixWithoutAnEcho{fix, static_cast<int>(skip)};
+    if (found) {
+      out.fix.failure = GroupFixFailure::kEchoUnidentified;
+      return out;
+    }
+    found = GroupFixWithoutAnEcho{fix, skip};
   }
   return found ? *found : out;
 }

@@ -43,6 +43,7 @@
 #include <deque>
 #include <map>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "beaconloc/core/beacon_calibration.hpp"
@@ -221,7 +222,9 @@ class ScanEstimator final : public EstimatorBase {
     Pose2 odometry_pose = Pose2::Zero();  // the dead-reckoned pose when it came
     StampNs integrated_ns = 0;            // odometry_integrated_ns_ then
   };
-  struct LastRange {  // a beacon's previous ranges that were not echoes, for its range rate
+  // A beacon's previous ranges, for its range rate: not those found to be echoes (longer than
+  // the receiver moved, or left out of a fix), though an echo neither check saw may be latest.
+  struct LastRange {
     StampNs newest_ns = 0;  // the stamp of its newest range, echo or not (a duplicate is refused)
     RangeSample latest;
     // The one before latest, for the range after an echo that was not caught (latest, when the
@@ -235,7 +238,8 @@ class ScanEstimator final : public EstimatorBase {
     RangeChange change = RangeChange::kTooOld;
     double rate_mps = 0.0;
   };
-  Compared compare(const RangeMeasurement& r, const RangeSample& before) const;
+  Compared compare(const RangeMeasurement& r, const RangeSample& predecessor) const;
+  void echo_left_out_of_fix(const EpochEntry& echo);
   std::map<std::uint32_t, LastRange> last_range_;  // by beacon
   // Sec. 3.6: the inputs since the robot last left a GRULPS, and when it came back to one.
   InputLog<RecordedInput> log_;
@@ -248,6 +252,8 @@ class ScanEstimator final : public EstimatorBase {
   std::size_t calibrated_since_grulps_ = 0;
   std::size_t inverse_passes_ = 0;
   std::size_t inverse_passes_skipped_ = 0;
+  std::size_t echoes_left_out_of_fixes_ = 0;  // solve_group_fix_without_an_echo
+  std::pair<std::uint32_t, StampNs> last_echo_left_out_{0, 0};  // its beacon and stamp
 };
 
 }  // namespace beaconloc::scan
