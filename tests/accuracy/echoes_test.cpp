@@ -9,8 +9,9 @@
 // between the groups, and a heading a few degrees off at a group's edge decides the run), and a
 // run with echoes draws the rest of its noise anew (sim_source.cpp), so ten seeds cannot tell
 // 1.5x and a seed's clean run is no reference for its run with echoes (docs/robustness.md). It
-// coasts by design: a run loses track when it ends (back in a globally referenced group) not ok,
-// or further off than kLostRatio times the worst clean run ends.
+// coasts by design: a run loses track when its E_p RMS is more than kLostRatio times the worst
+// clean run's, or when it ends (back in a globally referenced group) not ok or further off than
+// kLostRatio times the worst clean run ends.
 //   beaconloc accuracy --scenario examples/scenarios/seed003_scan.yaml --estimator scan --seeds 100 --fault echoes=P
 // Not asserted, because not met (printed by the same commands): uhl_last2 (the paper's
 // baseline without odometry, docs/robustness.md).
@@ -39,8 +40,9 @@ struct EchoSetup {
   const char* scenario;
   double echo_probability;
   int seeds = kSeeds;
-  // Lost track: E_p RMS more than kLostRatio times its seed's clean run; or (scan, above) the
-  // last pose not ok, or off by more than kLostRatio times the worst clean run's last pose.
+  // Lost track: E_p RMS more than kLostRatio times its seed's clean run; or (scan, above) more
+  // than kLostRatio times the worst clean run's, or the last pose not ok, or off by more than
+  // kLostRatio times the worst clean run's last pose.
   bool per_seed_reference = true;
 };
 
@@ -56,6 +58,8 @@ TEST_P(Echoes, CostAtMostHalfAgainTheCleanErrorAndNoSeedLosesTrack) {
   double clean_mean_m = 0.0;
   double faulty_mean_m = 0.0;
   double worst_seed_ratio = 0.0;
+  double worst_clean_m = 0.0;
+  double worst_faulty_m = 0.0;
   double worst_clean_end_m = 0.0;
   double worst_faulty_end_m = 0.0;
   int faulty_ends_not_ok = 0;
@@ -65,13 +69,17 @@ TEST_P(Echoes, CostAtMostHalfAgainTheCleanErrorAndNoSeedLosesTrack) {
     const OfflineRunResult f = run_scenario_offline(faulty, seed, setup.estimator, {});
     ASSERT_GT(c.metrics.samples, 0u) << "seed " << seed << ": the clean run scored no pose";
     ASSERT_GT(f.metrics.samples, 0u) << "seed " << seed << ": the run with echoes scored no pose";
-    ASSERT_TRUE(c.last_position_error_m && f.last_position_error_m) << "seed " << seed << ": no truth at the end";
     clean_mean_m += c.metrics.position_rms_m / seeds;
     faulty_mean_m += f.metrics.position_rms_m / seeds;
     worst_seed_ratio = std::max(worst_seed_ratio, f.metrics.position_rms_m / c.metrics.position_rms_m);
-    worst_clean_end_m = std::max(worst_clean_end_m, *c.last_position_error_m);
-    worst_faulty_end_m = std::max(worst_faulty_end_m, *f.last_position_error_m);
-    faulty_ends_not_ok += f.last_status != PoseStatus::kOk ? 1 : 0;
+    worst_clean_m = std::max(worst_clean_m, c.metrics.position_rms_m);
+    worst_faulty_m = std::max(worst_faulty_m, f.metrics.position_rms_m);
+    if (!setup.per_seed_reference) {
+      ASSERT_TRUE(c.last_position_error_m && f.last_position_error_m) << "seed " << seed << ": no pose with truth";
+      worst_clean_end_m = std::max(worst_clean_end_m, *c.last_position_error_m);
+      worst_faulty_end_m = std::max(worst_faulty_end_m, *f.last_position_error_m);
+      faulty_ends_not_ok += f.last_status != PoseStatus::kOk ? 1 : 0;
+    }
   }
   const double ratio = faulty_mean_m / clean_mean_m;
   std::printf("%s on %s, %d seeds, %.0f %% echoes: E_p RMS clean %.4f m, with echoes %.4f m, ratio %.3f (limit %.1f)",
@@ -82,8 +90,11 @@ TEST_P(Echoes, CostAtMostHalfAgainTheCleanErrorAndNoSeedLosesTrack) {
     std::printf("; worst seed %.2f x its clean run (limit %.1f)\n", worst_seed_ratio, kLostRatio);
     EXPECT_LE(worst_seed_ratio, kLostRatio);
   } else {
-    std::printf("; last pose off by at most %.3f m (the clean runs %.3f m, limit %.1f x), %d not ok\n",
-                worst_faulty_end_m, worst_clean_end_m, kLostRatio, faulty_ends_not_ok);
+    std::printf("; worst run %.2f x the worst clean run; last pose off by at most %.3f m (the clean runs %.3f m); "
+                "limit %.1f x; %d runs end not ok\n",
+                worst_faulty_m / worst_clean_m, worst_faulty_end_m, worst_clean_end_m, kLostRatio,
+                faulty_ends_not_ok);
+    EXPECT_LE(worst_faulty_m, kLostRatio * worst_clean_m);
     EXPECT_LE(worst_faulty_end_m, kLostRatio * worst_clean_end_m);
     EXPECT_EQ(faulty_ends_not_ok, 0);
   }

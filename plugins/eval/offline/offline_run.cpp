@@ -210,11 +210,11 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
     }
   }
   result.poses = rows.size();
-  if (!rows.empty()) {
-    const PoseEstimate& last = rows.back().estimate;
-    result.last_status = last.status;
-    if (const auto at = truth.at(last.stamp_ns)) {
-      result.last_position_error_m = (last.pose_map_base.head<2>() - at->pose_map_base.head<2>()).norm();
+  for (auto row = rows.rbegin(); row != rows.rend(); ++row) {
+    if (const auto at = truth.at(row->estimate.stamp_ns)) {
+      result.last_position_error_m = (row->estimate.pose_map_base.head<2>() - at->pose_map_base.head<2>()).norm();
+      result.last_status = row->estimate.status;
+      break;
     }
   }
   result.associations = stack.associations;

@@ -23,7 +23,8 @@ enum class GroupFixFailure : std::uint8_t {
   kNotConverged,      // no step under the tolerance within the iterations
   kResidualTooLarge,  // the fix does not explain its measurements (an echo, a wrong beacon): the
                       // whitened residuals' chi-square above its 99.9 % quantile for m - 2 dof
-  kEchoUnidentified,  // so, and more than one range could be the echo (solve_group_fix_without_an_echo)
+  kEchoUnidentified,  // the fix of them all failed, and more than one range could be the echo
+                      // (solve_group_fix_without_an_echo)
 };
 const char* to_string(GroupFixFailure failure);
 

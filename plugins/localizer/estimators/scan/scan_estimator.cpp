@@ -226,7 +226,8 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   // epoch, no fix and no filter (a filter's gate alone lets it through a calibrated beacon's wide
   // variance), and not the next range's predecessor; its stamp is kept for the duplicate check.
   if (an_echo) {
-    last_range_[r.beacon_id].newest_ns = std::max(last_range_[r.beacon_id].newest_ns, r.stamp_ns);
+    StampNs& newest_ns = last_range_[r.beacon_id].newest_ns;
+    newest_ns = std::max(newest_ns, r.stamp_ns);
     return InputResult::rejected(Rejection::kLongerThanTheReceiverMoved);
   }
 
@@ -388,22 +389,13 @@ std::optional<GroupFix> ScanEstimator::fix_of(const Epoch& epoch, bool global) {
   return fix;
 }
 
-// A range a fix found to be an echo: counted, and no longer its beacon's predecessor when it
-// still is one (the range before it is again).
+// A range a fix found to be an echo, counted once (an epoch may be fixed twice: checked against
+// the global filter, then starting it again).
 void ScanEstimator::echo_left_out_of_fix(const EpochEntry& echo) {
-  // An epoch may be fixed twice (checked against the global filter, then starting it again).
   const std::pair<std::uint32_t, StampNs> which{echo.beacon_id, echo.stamp_ns};
   if (which == last_echo_left_out_) return;
   last_echo_left_out_ = which;
   ++echoes_left_out_of_fixes_;
-  const auto last = last_range_.find(echo.beacon_id);
-  if (last == last_range_.end() || last->second.latest.stamp_ns != echo.stamp_ns) return;
-  if (last->second.before) {
-    last->second.latest = *last->second.before;
-    last->second.before.reset();
-  } else {
-    last_range_.erase(last);
-  }
 }
 
 std::optional<GroupFix> ScanEstimator::start_frame(Frame& frame, const Epoch& epoch, bool global) {

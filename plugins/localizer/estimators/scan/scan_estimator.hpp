@@ -29,9 +29,9 @@
 //    range that changed by more than the receiver moved since (odometry) has no rate: an echo is
 //    in one of the two, and an echo is the longer; a range longer than that is not the next
 //    one's predecessor either. A range shorter than that shows its predecessor was an echo the
-//    check could not see: its rate is taken from the range before. An epoch with a range to
-//    spare whose fix fails is fixed without the one range that is an echo
-//    (solve_group_fix_without_an_echo).
+//    check could not see: its rate is taken from the range before. A spherical epoch with a
+//    range to spare whose fix fails is fixed without the one range that is an echo
+//    (solve_group_fix_without_an_echo), counted (echoes_left_out_of_fixes).
 //  - a vector of the analytic average whose scale is off 1 by more than 10 % is left out of it
 //    (similarity_transform.hpp: the frames are in metres; one wrong pair spoils the mean).
 //  - the inverse trajectory (Sec. 3.6, inverse_trajectory.hpp): the inputs since the robot last
@@ -222,8 +222,8 @@ class ScanEstimator final : public EstimatorBase {
     Pose2 odometry_pose = Pose2::Zero();  // the dead-reckoned pose when it came
     StampNs integrated_ns = 0;            // odometry_integrated_ns_ then
   };
-  // A beacon's previous ranges, for its range rate: not those found to be echoes (longer than
-  // the receiver moved, or left out of a fix), though an echo neither check saw may be latest.
+  // A beacon's previous ranges, for its range rate: not those longer than the receiver moved
+  // (echoes), though an echo that check could not see may be latest.
   struct LastRange {
     StampNs newest_ns = 0;  // the stamp of its newest range, echo or not (a duplicate is refused)
     RangeSample latest;
@@ -253,7 +253,7 @@ class ScanEstimator final : public EstimatorBase {
   std::size_t inverse_passes_ = 0;
   std::size_t inverse_passes_skipped_ = 0;
   std::size_t echoes_left_out_of_fixes_ = 0;  // solve_group_fix_without_an_echo
-  std::pair<std::uint32_t, StampNs> last_echo_left_out_{0, 0};  // its beacon and stamp
+  std::optional<std::pair<std::uint32_t, StampNs>> last_echo_left_out_;  // its beacon and stamp
 };
 
 }  // namespace beaconloc::scan

@@ -270,7 +270,7 @@ class Ukf : public GaussianFilter<N> {
   // columns of P_xz, counting them; false when nothing is left to fuse.
   static bool leave_out_gated(const ComponentGate& gate, Eigen::VectorXd& innovation, Eigen::MatrixXd& s,
                               Eigen::MatrixXd& xz, int& gated) {
-    if (!(gate.sigmas > 0.0)) return true;  // no gate (and a NaN one gates nothing)
+    if (!(gate.sigmas > 0.0) || std::isinf(gate.sigmas)) return true;  // no gate (NaN and inf gate nothing)
     const Eigen::Index m = innovation.size();
     const Eigen::Index first = std::clamp<Eigen::Index>(gate.first, 0, m);
     const Eigen::Index last = first + std::clamp<Eigen::Index>(gate.count, 0, m - first);
