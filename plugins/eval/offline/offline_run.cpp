@@ -210,6 +210,13 @@ OfflineRunResult run_scenario_offline(const sim::Scenario& scenario, std::uint64
     }
   }
   result.poses = rows.size();
+  for (auto row = rows.rbegin(); row != rows.rend(); ++row) {
+    if (const auto at = truth.at(row->estimate.stamp_ns)) {
+      result.last_position_error_m = (row->estimate.pose_map_base.head<2>() - at->pose_map_base.head<2>()).norm();
+      result.last_status = row->estimate.status;
+      break;
+    }
+  }
   result.associations = stack.associations;
   result.rejections.add_rejections(stack.decoder.counts(), "decoder.");
   result.rejections.add_rejections(stack.localizer.counts(), "localizer.");

@@ -76,6 +76,9 @@ struct OfflineRunResult {
   std::uint64_t replays = 0;    // late measurements fused at their stamp by rolling back
   PoseBoundResult bound;  // the posterior Cramer-Rao bound over the stamps scored (pose_bound.hpp)
   std::vector<Estimator::StateValue> last_state;  // the estimator's state as last published
+  // The position error and status of the last pose that has truth at its stamp (nullopt: none).
+  std::optional<double> last_position_error_m;
+  PoseStatus last_status = PoseStatus::kInitializing;
 };
 
 // How the measurements reach the localizer: in stamp order, or each TOF and scan late by a

@@ -3,6 +3,8 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <optional>
 
 #include "beaconloc/core/chi_square.hpp"
 
@@ -65,13 +67,15 @@ const char* to_string(GroupFixFailure failure) {
     case GroupFixFailure::kSingular: return "singular";
     case GroupFixFailure::kNotConverged: return "not_converged";
     case GroupFixFailure::kResidualTooLarge: return "residual_too_large";
+    case GroupFixFailure::kEchoUnidentified: return "echo_unidentified";
   }
   return "unknown";
 }
 
+std::size_t ranges_for_a_fix(Geometry g) { return g == Geometry::kSpherical ? 3 : 4; }
+
 GroupFix solve_group_fix(const GroupMeasurements& m, const GroupFixSettings& settings) {
-  const std::size_t needed = m.geometry == Geometry::kSpherical ? 3 : 4;
-  if (m.beacons_m.size() != m.ranges_m.size() || m.beacons_m.size() < needed) {
+  if (m.beacons_m.size() != m.ranges_m.size() || m.beacons_m.size() < ranges_for_a_fix(m.geometry)) {
     return failed(GroupFixFailure::kTooFewBeacons);
   }
   Eigen::Vector2d p = Eigen::Vector2d::Zero();
@@ -118,6 +122,40 @@ GroupFix solve_group_fix(const GroupMeasurements& m, const GroupFixSettings& set
     }
   }
   return failed(GroupFixFailure::kNotConverged, settings.max_iterations);
+}
+
+GroupFixWithoutAnEcho solve_group_fix_without_an_echo(const GroupMeasurements& m, const GroupFixSettings& settings) {
+  GroupFixWithoutAnEcho out{solve_group_fix(m, settings), std::nullopt};
+  const bool spoiled = out.fix.failure == GroupFixFailure::kResidualTooLarge ||
+                       out.fix.failure == GroupFixFailure::kNotConverged ||
+                       out.fix.failure == GroupFixFailure::kSingular;
+  if (!spoiled || m.geometry != Geometry::kSpherical || m.ranges_m.size() != m.beacons_m.size() ||
+      m.ranges_m.size() < ranges_for_a_fix(m.geometry) + 1) {
+    return out;
+  }
+  const double variance_m2 = m.range_sigma_m * m.range_sigma_m;
+  std::optional<GroupFixWithoutAnEcho> found;
+  for (std::size_t skip = 0; skip < m.ranges_m.size(); ++skip) {
+    GroupMeasurements subset = m;
+    subset.beacons_m.erase(subset.beacons_m.begin() + static_cast<std::ptrdiff_t>(skip));
+    subset.ranges_m.erase(subset.ranges_m.begin() + static_cast<std::ptrdiff_t>(skip));
+    const GroupFix fix = solve_group_fix(subset, settings);
+    if (!fix.ok()) continue;
+    // The left-out range against the one the subset's fix predicts, in sigmas of the range and of
+    // the prediction (the fix is made of the other ranges: the two are independent).
+    const auto left = RangeModel(Eigen::Vector2d::Zero(), m.receiver_z_m, m.beacons_m[skip], variance_m2)
+                          .linearize(Vec<3>(fix.position_m.x(), fix.position_m.y(), 0.0));
+    const Eigen::RowVector2d jacobian = left.jacobian.leftCols<2>();
+    const double excess_m = m.ranges_m[skip] - left.predicted(0);
+    const double sigma_m = std::sqrt(variance_m2 + jacobian * fix.covariance_m2 * jacobian.transpose());
+    if (!(excess_m > kEchoExcessSigma * sigma_m)) continue;
+    if (found) {
+      out.fix.failure = GroupFixFailure::kEchoUnidentified;
+      return out;
+    }
+    found = GroupFixWithoutAnEcho{fix, skip};
+  }
+  return found ? *found : out;
 }
 
 }  // namespace beaconloc::scan

@@ -6,7 +6,9 @@
 // known height z_MR, so only the position is found; the heading comes from two fixes (Fig. 5, 7).
 // The measurement models are the core's (RangeModel, RangeDifferenceModel), the same the filters use.
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace beaconloc::scan {
@@ -21,6 +23,8 @@ enum class GroupFixFailure : std::uint8_t {
   kNotConverged,      // no step under the tolerance within the iterations
   kResidualTooLarge,  // the fix does not explain its measurements (an echo, a wrong beacon): the
                       // whitened residuals' chi-square above its 99.9 % quantile for m - 2 dof
+  kEchoUnidentified,  // the fix of them all failed, and more than one range could be the echo
+                      // (solve_group_fix_without_an_echo)
 };
 const char* to_string(GroupFixFailure failure);
 
@@ -46,7 +50,25 @@ struct GroupFix {
   bool ok() const { return failure == GroupFixFailure::kNone; }
 };
 
+// Sec. 2: three ranges at least for a spherical fix, four beacons for a hyperbolic one.
+std::size_t ranges_for_a_fix(Geometry g);
+
 // Starts under the group's centroid (the robot hears the group: it is within its coverage).
 GroupFix solve_group_fix(const GroupMeasurements& m, const GroupFixSettings& settings = {});
+
+// Not in the paper: an echo (a reflection's longer path) spoils one range of an epoch, and the fix
+// of them all fails. Spherical, with a range more than a fix needs: each range is left out in
+// turn, and the fix is that of the one subset whose own fix passes its gate and predicts the range
+// it left out shorter than measured by more than kEchoExcessSigma of that range (an echo is only
+// ever longer). More than one such subset: kEchoUnidentified; none, or hyperbolic (three
+// differences of four beacons leave one degree of freedom, and a wrong subset fits as well as
+// the right one): the fix of them all, with its failure.
+inline constexpr double kEchoExcessSigma = 3.0;
+struct GroupFixWithoutAnEcho {
+  GroupFix fix;
+  std::optional<std::size_t> left_out;  // the range left out, as an index into the measurements
+};
+GroupFixWithoutAnEcho solve_group_fix_without_an_echo(const GroupMeasurements& m,
+                                                      const GroupFixSettings& settings = {});
 
 }  // namespace beaconloc::scan

@@ -15,18 +15,15 @@
 namespace beaconloc::scan {
 namespace {
 
-// A beacon's range rate is taken from its previous range when that is at most this old (two of
-// seed003_scan.yaml's 0.76 s cycles, with one missed).
-constexpr StampNs kRangeRateWindowNs = 2 * kNsPerSecond;
+// A beacon's range rate is taken from a previous range at most this old (seed003_scan.yaml's
+// group cycle is 0.76 s: three cycles, two of them missed, and some margin).
+constexpr StampNs kRangeRateWindowNs = 3 * kNsPerSecond;
 // More ranges in one group's epoch than any ULPS has beacons (the paper's have 4-5): a flood,
 // refused before a Gauss-Newton fix over them costs O(n^3) per iteration.
 constexpr std::size_t kMaxEpochRanges = 64;
 // A frame relocates after this many GRULPS fixes in a row contradict it (one may be an echo's),
 // and stops relocating after as many agree.
 constexpr int kFixesToRelocate = 2;
-
-// Sec. 2: three beacons at least for a spherical fix, four for a hyperbolic one.
-std::size_t beacons_for_a_fix(Geometry g) { return g == Geometry::kSpherical ? 3 : 4; }
 
 }  // namespace
 
@@ -62,7 +59,7 @@ ScanEstimator::ScanEstimator(const EstimatorConfig& config, const ScanParameters
       global_(params) {
   // Sec. 3.2: one receiver (Sec. 5: a microphone on the robot); its fixes are its own position.
   if (receivers_.size() != 1) throw std::invalid_argument("scan: the robot must have exactly one receiver (seed 003)");
-  waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(beacons_for_a_fix(params_.geometry)), {}};
+  waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(ranges_for_a_fix(params_.geometry)), {}};
 }
 
 // Everything measured against the beacons goes with the map they were measured against (the
@@ -84,7 +81,7 @@ void ScanEstimator::set_beacon_map(const BeaconMap& map) {
   back_in_grulps_since_ns_.reset();
   calibrated_since_grulps_ = 0;
   calibrated_correction_m2_.setZero();  // the old map's calibrated groups no longer correct the pose
-  waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(beacons_for_a_fix(params_.geometry)), {}};
+  waiting_for_ = {StartupCondition::kTooFewBeacons, 0.0, static_cast<double>(ranges_for_a_fix(params_.geometry)), {}};
 }
 
 bool ScanEstimator::use_calibration(const BeaconCalibration& c) {
@@ -172,6 +169,23 @@ InputResult ScanEstimator::predict(const OdometrySample& o) {
   return InputResult::ok();
 }
 
+ScanEstimator::Compared ScanEstimator::compare(const RangeMeasurement& r, const RangeSample& predecessor) const {
+  const StampNs dt_ns = r.stamp_ns - predecessor.stamp_ns;
+  if (dt_ns <= 0 || dt_ns > kRangeRateWindowNs) return {};
+  // What the receiver moved: the odometry's displacement, 5 % of it for the odometry's error, and
+  // 4 sigma of the two ranges. Time between the two the odometry did not integrate (a gap, or
+  // before its first sample): the receiver may have moved as fast as any robot then.
+  const Eigen::Vector2d& rx = receivers_.receivers_base_m[0];
+  const double moved_m =
+      (transform_point(odometry_pose_, rx) - transform_point(predecessor.odometry_pose, rx)).norm();
+  const StampNs unseen_ns = dt_ns - (odometry_integrated_ns_ - predecessor.integrated_ns);
+  const double unseen_m = unseen_ns > s_to_ns(params_.epoch_window_s) ? kMaxWheelSpeedMps * ns_to_s(unseen_ns) : 0.0;
+  const double allowed_m = 1.05 * moved_m + unseen_m + 4.0 * std::sqrt(r.variance_m2 + predecessor.variance_m2);
+  const double change_m = r.range_m - predecessor.range_m;
+  if (std::abs(change_m) <= allowed_m) return {RangeChange::kWithinMotion, change_m / ns_to_s(dt_ns)};
+  return {change_m > 0.0 ? RangeChange::kLonger : RangeChange::kShorter, 0.0};
+}
+
 InputResult ScanEstimator::update(const RangeMeasurement& r) {
   if (InputResult numbers = check_range_numbers(r); !numbers.accepted) return numbers;
   if (r.beacon_id == kBeaconUnidentified) return InputResult::rejected(Rejection::kUnassociatedRange);
@@ -190,36 +204,30 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
     return InputResult::rejected(Rejection::kDuplicateRange);
   }
 
+  // A range cannot change by more than the receiver moved (compare): a larger change is an
+  // echo's (its extra path is 0.3 m or more), and its "rate" would move the range wrongly. An
+  // echo is longer than the direct path: this range, when it grew too much (kept out of the
+  // rates, the previous one stays the reference); the previous, when it shrank too much, and
+  // then the rate is taken from the one before that, when it is within the motion.
   std::optional<double> rate_mps;
-  bool an_echo = false;  // longer than the beacon's previous range allows
+  bool an_echo = false;          // longer than the beacon's previous range allows
+  bool after_an_echo = false;    // shorter: the previous range was an echo
   if (auto last = last_range_.find(r.beacon_id); last != last_range_.end()) {
-    const LastRange& before = last->second;
-    const StampNs dt_ns = r.stamp_ns - before.stamp_ns;
-    // A range cannot change by more than the receiver moved (the odometry's displacement, 5 % of
-    // it for the odometry's error, and 4 sigma of the two ranges): a larger change is an echo's
-    // (its extra path is 0.3 m or more), and its "rate" would move the range wrongly. An echo is
-    // longer than the direct path: this range, when it grew too much (kept out of the rates, the
-    // previous one stays the reference); the previous, when it shrank too much.
-    // Time between the two the odometry did not integrate (a gap, or before its first sample):
-    // the receiver may have moved as fast as any robot then.
-    const Eigen::Vector2d& rx = receivers_.receivers_base_m[0];
-    const double moved_m = (transform_point(odometry_pose_, rx) - transform_point(before.odometry_pose, rx)).norm();
-    const StampNs unseen_ns = dt_ns - (odometry_integrated_ns_ - before.integrated_ns);
-    const double unseen_m = unseen_ns > s_to_ns(params_.epoch_window_s) ? kMaxWheelSpeedMps * ns_to_s(unseen_ns) : 0.0;
-    const double allowed_m = 1.05 * moved_m + unseen_m + 4.0 * std::sqrt(r.variance_m2 + before.variance_m2);
-    if (dt_ns > 0 && dt_ns <= kRangeRateWindowNs) {
-      if (std::abs(r.range_m - before.range_m) <= allowed_m) {
-        rate_mps = (r.range_m - before.range_m) / ns_to_s(dt_ns);
-      } else {
-        an_echo = r.range_m > before.range_m;
-      }
+    const Compared latest = compare(r, last->second.latest);
+    an_echo = latest.change == RangeChange::kLonger;
+    after_an_echo = latest.change == RangeChange::kShorter;
+    if (latest.change == RangeChange::kWithinMotion) rate_mps = latest.rate_mps;
+    if (after_an_echo && last->second.before) {
+      const Compared before = compare(r, *last->second.before);
+      if (before.change == RangeChange::kWithinMotion) rate_mps = before.rate_mps;
     }
   }
   // Longer than its beacon's previous range by more than the receiver moved: an echo, in no
   // epoch, no fix and no filter (a filter's gate alone lets it through a calibrated beacon's wide
   // variance), and not the next range's predecessor; its stamp is kept for the duplicate check.
   if (an_echo) {
-    last_range_[r.beacon_id].newest_ns = std::max(last_range_[r.beacon_id].newest_ns, r.stamp_ns);
+    StampNs& newest_ns = last_range_[r.beacon_id].newest_ns;
+    newest_ns = std::max(newest_ns, r.stamp_ns);
     return InputResult::rejected(Rejection::kLongerThanTheReceiverMoved);
   }
 
@@ -246,12 +254,9 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   // The next range's predecessor: this one, when newer than the reference (an older one, pushed
   // out of order, is not).
   LastRange& ref = last_range_[r.beacon_id];
-  if (r.stamp_ns > ref.stamp_ns || ref.newest_ns == 0) {
-    ref.stamp_ns = r.stamp_ns;
-    ref.range_m = r.range_m;
-    ref.variance_m2 = r.variance_m2;
-    ref.odometry_pose = odometry_pose_;
-    ref.integrated_ns = odometry_integrated_ns_;
+  if (r.stamp_ns > ref.latest.stamp_ns || ref.newest_ns == 0) {
+    if (ref.newest_ns != 0 && !after_an_echo) ref.before = ref.latest;  // an echo is no one's predecessor
+    ref.latest = {r.stamp_ns, r.range_m, r.variance_m2, odometry_pose_, odometry_integrated_ns_};
   }
   ref.newest_ns = std::max(ref.newest_ns, r.stamp_ns);
   epoch.ranges.push_back({r.beacon_id, r.range_m, r.variance_m2, odometry_pose_, r.stamp_ns, rate_mps});
@@ -348,6 +353,7 @@ std::optional<GroupFix> ScanEstimator::fix_of(const Epoch& epoch, bool global) {
   m.receiver_z_m = receivers_.receiver_height_m;
   double variance_sum = 0.0;
   const StampNs reference_ns = epoch.ranges.back().stamp_ns;
+  std::vector<const EpochEntry*> used;  // beside m's ranges
   for (const EpochEntry& e : epoch.ranges) {
     if (!e.range_rate_mps) continue;  // cannot be brought to the epoch's last instant (see the header)
     if (global) {
@@ -360,10 +366,11 @@ std::optional<GroupFix> ScanEstimator::fix_of(const Epoch& epoch, bool global) {
       m.beacons_m.push_back(b->position_group_m);
     }
     m.ranges_m.push_back(e.range_m + *e.range_rate_mps * ns_to_s(reference_ns - e.stamp_ns));
+    used.push_back(&e);
     variance_sum += e.variance_m2;
   }
   const bool first_pose = global && !global_.started;
-  const std::size_t needed = beacons_for_a_fix(params_.geometry);
+  const std::size_t needed = ranges_for_a_fix(params_.geometry);
   if (m.beacons_m.size() < needed) {
     if (first_pose) {
       waiting_for_ = {StartupCondition::kTooFewBeacons, static_cast<double>(m.beacons_m.size()),
@@ -372,12 +379,23 @@ std::optional<GroupFix> ScanEstimator::fix_of(const Epoch& epoch, bool global) {
     return std::nullopt;
   }
   m.range_sigma_m = std::sqrt(variance_sum / static_cast<double>(m.ranges_m.size()));
-  const GroupFix fix = solve_group_fix(m);
+  const GroupFixWithoutAnEcho solved = solve_group_fix_without_an_echo(m);
+  if (solved.left_out) echo_left_out_of_fix(*used[*solved.left_out]);
+  const GroupFix& fix = solved.fix;
   if (!fix.ok()) {
     if (first_pose) waiting_for_ = {StartupCondition::kFixFailed, 0.0, 0.0, to_string(fix.failure)};
     return std::nullopt;
   }
   return fix;
+}
+
+// A range a fix found to be an echo, counted once (an epoch may be fixed twice: checked against
+// the global filter, then starting it again).
+void ScanEstimator::echo_left_out_of_fix(const EpochEntry& echo) {
+  const std::pair<std::uint32_t, StampNs> which{echo.beacon_id, echo.stamp_ns};
+  if (which == last_echo_left_out_) return;
+  last_echo_left_out_ = which;
+  ++echoes_left_out_of_fixes_;
 }
 
 std::optional<GroupFix> ScanEstimator::start_frame(Frame& frame, const Epoch& epoch, bool global) {
@@ -619,7 +637,8 @@ void ScanEstimator::finish() {
 std::vector<Estimator::StateValue> ScanEstimator::state_values() const {
   return {{"calibrated_groups", static_cast<double>(calibration_.groups.size()), 0.0},
           {"inverse_passes", static_cast<double>(inverse_passes_), 0.0},
-          {"inverse_passes_skipped", static_cast<double>(inverse_passes_skipped_), 0.0}};
+          {"inverse_passes_skipped", static_cast<double>(inverse_passes_skipped_), 0.0},
+          {"echoes_left_out_of_fixes", static_cast<double>(echoes_left_out_of_fixes_), 0.0}};
 }
 
 BEACONLOC_REGISTER_ESTIMATOR("scan",

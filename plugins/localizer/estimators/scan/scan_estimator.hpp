@@ -28,7 +28,10 @@
 //    previous range (one group cycle before); a range without a recent predecessor waits. A
 //    range that changed by more than the receiver moved since (odometry) has no rate: an echo is
 //    in one of the two, and an echo is the longer; a range longer than that is not the next
-//    one's predecessor either.
+//    one's predecessor either. A range shorter than that shows its predecessor was an echo the
+//    check could not see: its rate is taken from the range before. A spherical epoch with a
+//    range to spare whose fix fails is fixed without the one range that is an echo
+//    (solve_group_fix_without_an_echo), counted (echoes_left_out_of_fixes).
 //  - a vector of the analytic average whose scale is off 1 by more than 10 % is left out of it
 //    (similarity_transform.hpp: the frames are in metres; one wrong pair spoils the mean).
 //  - the inverse trajectory (Sec. 3.6, inverse_trajectory.hpp): the inputs since the robot last
@@ -40,6 +43,7 @@
 #include <deque>
 #include <map>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "beaconloc/core/beacon_calibration.hpp"
@@ -211,14 +215,31 @@ class ScanEstimator final : public EstimatorBase {
   BeaconCalibration calibration_;
   bool calibration_changed_ = false;  // since take_calibration_update last asked
   std::map<std::uint32_t, Epoch> open_epochs_;  // by group
-  struct LastRange {  // a beacon's previous range that was not an echo, for its range rate
-    StampNs newest_ns = 0;  // the stamp of its newest range, echo or not (a duplicate is refused)
+  struct RangeSample {  // a range as the next one's predecessor
     StampNs stamp_ns = 0;
     double range_m = 0.0;
     double variance_m2 = 0.0;
     Pose2 odometry_pose = Pose2::Zero();  // the dead-reckoned pose when it came
     StampNs integrated_ns = 0;            // odometry_integrated_ns_ then
   };
+  // A beacon's previous ranges, for its range rate: not those longer than the receiver moved
+  // (echoes), though an echo that check could not see may be latest.
+  struct LastRange {
+    StampNs newest_ns = 0;  // the stamp of its newest range, echo or not (a duplicate is refused)
+    RangeSample latest;
+    // The one before latest, for the range after an echo that was not caught (latest, when the
+    // next range is shorter than the receiver's motion allows).
+    std::optional<RangeSample> before;
+  };
+  // How a range compares with a predecessor: within what the receiver moved since (rate_mps), or
+  // longer or shorter than that allows.
+  enum class RangeChange : std::uint8_t { kTooOld, kWithinMotion, kLonger, kShorter };
+  struct Compared {
+    RangeChange change = RangeChange::kTooOld;
+    double rate_mps = 0.0;
+  };
+  Compared compare(const RangeMeasurement& r, const RangeSample& predecessor) const;
+  void echo_left_out_of_fix(const EpochEntry& echo);
   std::map<std::uint32_t, LastRange> last_range_;  // by beacon
   // Sec. 3.6: the inputs since the robot last left a GRULPS, and when it came back to one.
   InputLog<RecordedInput> log_;
@@ -231,6 +252,8 @@ class ScanEstimator final : public EstimatorBase {
   std::size_t calibrated_since_grulps_ = 0;
   std::size_t inverse_passes_ = 0;
   std::size_t inverse_passes_skipped_ = 0;
+  std::size_t echoes_left_out_of_fixes_ = 0;  // solve_group_fix_without_an_echo
+  std::optional<std::pair<std::uint32_t, StampNs>> last_echo_left_out_;  // its beacon and stamp
 };
 
 }  // namespace beaconloc::scan

@@ -261,7 +261,7 @@ InputResult UkfLrf::step(std::optional<Motion> motion, std::vector<RangeMeasurem
   // Eq. 15-22, the beams that are gross outliers on their own left out (beam_gate_sigma).
   const UpdateResult corrected_by = filter_.update(
       *points, model, z, std::numeric_limits<double>::infinity(),
-      params_.beam_gate_sigma > 0.0 ? ComponentGate{n_b, n_w, params_.beam_gate_sigma} : ComponentGate{});
+      ComponentGate{n_b, n_w, params_.beam_gate_sigma});  // 0: no gate (the paper)
   // Counted when they were left out: of an update applied, or one that had nothing else to fuse.
   if (corrected_by.applied() || corrected_by.outcome == FilterOutcome::kEveryComponentGated) {
     beams_gated_ += static_cast<std::uint64_t>(corrected_by.components_gated);

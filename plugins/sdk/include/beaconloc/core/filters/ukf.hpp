@@ -270,23 +270,24 @@ class Ukf : public GaussianFilter<N> {
   // columns of P_xz, counting them; false when nothing is left to fuse.
   static bool leave_out_gated(const ComponentGate& gate, Eigen::VectorXd& innovation, Eigen::MatrixXd& s,
                               Eigen::MatrixXd& xz, int& gated) {
-    if (!(gate.sigmas > 0.0)) return true;  // no gate (and a NaN one gates nothing)
+    if (!(gate.sigmas > 0.0) || std::isinf(gate.sigmas)) return true;  // no gate (NaN and inf gate nothing)
     const Eigen::Index m = innovation.size();
     const Eigen::Index first = std::clamp<Eigen::Index>(gate.first, 0, m);
     const Eigen::Index last = first + std::clamp<Eigen::Index>(gate.count, 0, m - first);
+    const double limit = gate.sigmas * gate.sigmas;
+    const auto gated_out = [&](Eigen::Index i) {
+      return i >= first && i < last && !(innovation(i) * innovation(i) <= limit * s(i, i));
+    };
+    Eigen::Index dropped = 0;
+    for (Eigen::Index i = 0; i < m; ++i) dropped += gated_out(i) ? 1 : 0;
+    gated += static_cast<int>(dropped);
+    if (dropped == 0) return true;  // the common case: nothing to copy
+    if (dropped == m) return false;
     std::vector<Eigen::Index> kept;
-    kept.reserve(static_cast<std::size_t>(m));
+    kept.reserve(static_cast<std::size_t>(m - dropped));
     for (Eigen::Index i = 0; i < m; ++i) {
-      const bool gated_out =
-          i >= first && i < last && !(innovation(i) * innovation(i) <= gate.sigmas * gate.sigmas * s(i, i));
-      if (gated_out) {
-        ++gated;
-      } else {
-        kept.push_back(i);
-      }
+      if (!gated_out(i)) kept.push_back(i);
     }
-    if (gated == 0) return true;
-    if (kept.empty()) return false;
     innovation = Eigen::VectorXd(innovation(kept));
     s = Eigen::MatrixXd(s(kept, kept));
     xz = Eigen::MatrixXd(xz(Eigen::all, kept));
