@@ -129,8 +129,8 @@ GroupFixWithoutAnEcho solve_group_fix_without_an_echo(const GroupMeasurements& m
   const bool spoiled = out.fix.failure == GroupFixFailure::kResidualTooLarge ||
                        out.fix.failure == GroupFixFailure::kNotConverged ||
                        out.fix.failure == GroupFixFailure::kSingular;
-  if (!spoiled || m.geometry != Geometry::kSpherical || m.ranges_m.size() != m.beacons_m.size() ||
-      m.ranges_m.size() < ranges_for_a_fix(m.geometry) + 1) {
+  // (Mismatched sizes are kTooFewBeacons, not spoiled.)
+  if (!spoiled || m.geometry != Geometry::kSpherical || m.ranges_m.size() < ranges_for_a_fix(m.geometry) + 1) {
     return out;
   }
   const double variance_m2 = m.range_sigma_m * m.range_sigma_m;

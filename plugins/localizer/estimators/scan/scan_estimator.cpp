@@ -200,7 +200,8 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   if (now_ns() && r.stamp_ns > *now_ns() + s_to_ns(params_.epoch_window_s)) {
     return InputResult::rejected(Rejection::kAheadOfOdometry);
   }
-  if (auto last = last_range_.find(r.beacon_id); last != last_range_.end() && last->second.newest_ns == r.stamp_ns) {
+  const auto last = last_range_.find(r.beacon_id);  // this beacon's previous ranges, if any
+  if (last != last_range_.end() && last->second.newest_ns == r.stamp_ns) {
     return InputResult::rejected(Rejection::kDuplicateRange);
   }
 
@@ -212,7 +213,7 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   std::optional<double> rate_mps;
   bool an_echo = false;          // longer than the beacon's previous range allows
   bool after_an_echo = false;    // shorter: the previous range was an echo
-  if (auto last = last_range_.find(r.beacon_id); last != last_range_.end()) {
+  if (last != last_range_.end()) {
     const Compared latest = compare(r, last->second.latest);
     an_echo = latest.change == RangeChange::kLonger;
     after_an_echo = latest.change == RangeChange::kShorter;
@@ -226,8 +227,7 @@ InputResult ScanEstimator::update(const RangeMeasurement& r) {
   // epoch, no fix and no filter (a filter's gate alone lets it through a calibrated beacon's wide
   // variance), and not the next range's predecessor; its stamp is kept for the duplicate check.
   if (an_echo) {
-    StampNs& newest_ns = last_range_[r.beacon_id].newest_ns;
-    newest_ns = std::max(newest_ns, r.stamp_ns);
+    last->second.newest_ns = std::max(last->second.newest_ns, r.stamp_ns);  // an echo has a predecessor
     return InputResult::rejected(Rejection::kLongerThanTheReceiverMoved);
   }
 
