@@ -12,6 +12,7 @@ build_both_trees() {
   tree=build/compare/$base_sha
   if [ ! -d "$tree" ]; then
     mkdir -p build/compare
+    git worktree prune  # a worktree removed with build/ leaves its registration behind
     git worktree add --detach "$tree" "$base_sha" >/dev/null
   fi
   # The base tree needs ../shared beside it, as the repository does.

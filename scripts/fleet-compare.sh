@@ -3,28 +3,29 @@
 # bare Fast DDS relay as the yardstick (issue 19: "each lever measured on its own"; "the bare
 # Fast DDS cost of the same sample rates measured in the same run"). Builds the fleet benchmark
 # and `beaconloc` (Release) at BASE in a git worktree under build/compare/, and at the working
-# tree in build/release, then runs, ROUNDS times in turn for each robot count: BASE's localizer,
-# this tree's localizer, and this tree's --bare relay. Prints, per robot count and side, the
-# median of each figure over the rounds and how many rounds were in real time.
+# tree in build/release, then runs, ROUNDS rounds for each robot count, each round in this order:
+# BASE's localizer, this tree's localizer, this tree's --bare relay. Prints, per robot count and
+# side, the median of each figure over the rounds and how many rounds were in real time.
 #
 #   bash scripts/fleet-compare.sh [BASE] [ROUNDS] [ROBOTS]
 #
 #   BASE     the commit to compare with (default HEAD~1).
 #   ROUNDS   default 3.
 #   ROBOTS   robot counts, quoted (default "300").
-# Writes every run's rows to build/compare/<BASE>-fleet/results.csv. Each run leases its own DDS
-# domain and uses the loopback-only profile. Run it on a quiet machine.
+# Writes every run's rows to build/compare/<BASE>-fleet-<time>/results.csv, and each run's output
+# beside it. Each run leases its own DDS domain and uses the loopback-only profile. Run it on a
+# quiet machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 base=${1:-HEAD~1}
 rounds=${2:-3}
 robots=${3:-300}
+[[ "$rounds" =~ ^[1-9][0-9]*$ ]] || { echo "fleet-compare: ROUNDS must be a positive number, not '$rounds'" >&2; exit 2; }
 . scripts/compare-trees.sh
 build_both_trees "$base" beaconloc beaconloc_fleet_benchmark
 before="$tree/build/benchmarks/fleet/beaconloc_fleet_benchmark"
 after=build/release/benchmarks/fleet/beaconloc_fleet_benchmark
-out=build/compare/$base_sha-fleet
-rm -rf "$out"
+out=build/compare/$base_sha-fleet-$(date +%Y%m%dT%H%M%S)
 mkdir -p "$out"
 csv="$out/results.csv"
 for n in $robots; do
@@ -35,13 +36,14 @@ for n in $robots; do
         before) "$before" --robots "$n" --warmup-s 5 --window-s 10 --csv "$out/before.csv" ;;
         after) "$after" --robots "$n" --warmup-s 5 --window-s 10 --csv "$out/after.csv" ;;
         bare) "$after" --robots "$n" --warmup-s 5 --window-s 10 --bare --csv "$out/bare.csv" ;;
-      esac >/dev/null
+      esac > "$out/$side-$n-$i.log"
+      grep -h "logs kept in" "$out/$side-$n-$i.log" || true
     done
   done
 done
 for side in before after bare; do sed "s/^/$side,/" "$out/$side.csv"; done > "$csv"
 echo "# $(nproc) cores; before = $base_sha, after = working tree of $(git rev-parse --short=10 HEAD)," \
-  "bare = after --bare; $rounds rounds, alternating; medians over the rounds"
+  "bare = after --bare; $rounds rounds, each before, after, bare; medians over the rounds; every run in $out"
 awk -F, '
   $3 == "case" { next }
   { side = $1; n = $3; sub(/robots=/, "", n); metric = $4; key = n SUBSEP side SUBSEP metric

@@ -62,6 +62,18 @@ TEST(DeadlineWatch, AChecksGapCountsEveryPeriodMissedInOneCall) {
   EXPECT_EQ(missed, static_cast<std::uint64_t>((86400 * kNsPerSecond - 250 * kNsPerMillisecond) / kPeriod + 1));
 }
 
+TEST(DeadlineWatch, AForgottenKeyMissesNothingUntilItsNextSample) {
+  DeadlineWatch<std::string> watch(kPeriod);
+  watch.on_sample("gone", 0);
+  watch.on_sample("stays", 0);
+  watch.forget("gone");  // its writer ended the instance
+  EXPECT_EQ(expire(watch, kNsPerSecond), std::vector<std::string>{"stays"});
+  watch.on_sample("gone", kNsPerSecond);  // back: watched again
+  EXPECT_EQ(expire(watch, kNsPerSecond + kPeriod), (std::vector<std::string>{"gone", "stays"}));
+  watch.forget("never heard");  // nothing to forget: no effect
+  EXPECT_EQ(watch.size(), 2u);
+}
+
 TEST(DeadlineWatch, APeriodThatIsNotPositiveIsRefused) {
   EXPECT_THROW(DeadlineWatch<int>(0), std::invalid_argument);
   EXPECT_THROW(DeadlineWatch<int>(-kPeriod), std::invalid_argument);

@@ -25,13 +25,19 @@ class DeadlineWatch {
   StampNs period_ns() const { return period_ns_; }
 
   // A sample of `key` arrived at now_ns: its next deadline is a period later. A key is watched
-  // from its first sample on, and never forgotten (a robot whose gateway died goes on missing).
+  // from its first sample on, until forgotten.
   void on_sample(const Key& key, StampNs now_ns) { next_deadline_ns_[key] = now_ns + period_ns_; }
+
+  // Stops watching `key` until its next sample (its writer ended the instance, as the QoS stops
+  // with an instance that is no longer alive).
+  void forget(const Key& key) { next_deadline_ns_.erase(key); }
 
   // Calls on_missed(key) for each key whose deadline passed by now_ns, and moves its deadline
   // on by whole periods past now_ns; returns how many periods were missed in all (silent for
-  // three periods since the last check: three misses, one call). Checked more often than the
-  // period, a key silent for n periods gets n calls, one per period, as the QoS's listener does.
+  // three periods since the last check: three misses, one call; so a process that stalled for
+  // S seconds counts S / period misses for each key, where the QoS counted about one). Checked
+  // more often than the period, a key silent for n periods gets n calls, one per period, as the
+  // QoS's listener does.
   template <class OnMissed>
   std::uint64_t expire(StampNs now_ns, OnMissed&& on_missed) {
     std::uint64_t missed = 0;

@@ -84,15 +84,24 @@ inline std::string writer_id(const eprosima::fastdds::dds::InstanceHandle_t& pub
 
 // Takes every valid sample a reader has and hands it to a callback with its SampleInfo; keeps
 // the topic's deadline per instance (TopicSpec::deadline_ns: a DeadlineWatch checked on a thread
-// of its own, four times per period, so a miss is told 1-1.25 periods after the last sample),
-// counts writers that lost liveliness, and tells which writers went away.
+// of its own about four times per period, so a miss is told 1-1.3 periods after the last sample
+// taken; a sample its lifespan dropped, or one that could not be decoded, does not count); counts
+// writers that lost liveliness, and tells which writers went away.
+// The misses are told under the watch's lock, so that a miss is never told after the sample that
+// ended it (on_sample runs after the sample renewed the deadline): a participant must not take,
+// inside on_deadline_missed, a lock under which it writes a topic it watches itself.
 template <class Msg>
 class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
  public:
   using OnSample = std::function<void(const Msg&, const eprosima::fastdds::dds::SampleInfo&)>;
+  // Throws std::logic_error when events ask for deadline misses of a topic without a deadline.
   SampleListener(OnSample on_sample, ReaderEvents<Msg> events, std::int64_t deadline_ns)
       : on_sample_(std::move(on_sample)), events_(std::move(events)) {
-    if (deadline_ns > 0 && (events_.deadline_misses || events_.on_deadline_missed)) {
+    const bool deadline_asked = events_.deadline_misses || events_.on_deadline_missed;
+    if (deadline_asked && deadline_ns <= 0) {
+      throw std::logic_error("deadline misses asked of a reader whose topic has no deadline");
+    }
+    if (deadline_asked) {
       watch_.emplace(deadline_ns);
       const auto tick = std::max(std::chrono::milliseconds(1),
                                  std::chrono::duration_cast<std::chrono::milliseconds>(
@@ -105,6 +114,12 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
     eprosima::fastdds::dds::SampleInfo info;
     while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) {
+        if (watch_) {
+          // Disposed, unregistered, or its writers gone: no longer watched, as the QoS drops an
+          // instance that is not alive (a dead gateway is told by liveliness instead).
+          std::lock_guard<std::mutex> lock(watch_mutex_);
+          watch_->forget(info.instance_handle);
+        }
         if (events_.on_instance_ended) events_.on_instance_ended(info);
         continue;
       }
@@ -146,21 +161,16 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
         .count();
   }
-  // On the checks' thread: the instances past their deadline, told outside the lock (the
-  // callback takes its participant's).
+  // On the checks' thread: the instances past their deadline, told under the watch's lock.
   void check_deadlines() {
-    std::vector<Msg> missed_keys;
-    std::uint64_t missed = 0;
-    {
-      std::lock_guard<std::mutex> lock(watch_mutex_);
-      missed = watch_->expire(steady_ns(), [&](const eprosima::fastdds::dds::InstanceHandle_t& handle) {
-        if (!events_.on_deadline_missed) return;
-        const auto it = keys_.find(handle);
-        if (it != keys_.end()) missed_keys.push_back(it->second);
-      });
-    }
+    std::lock_guard<std::mutex> lock(watch_mutex_);
+    const std::uint64_t missed =
+        watch_->expire(steady_ns(), [&](const eprosima::fastdds::dds::InstanceHandle_t& handle) {
+          if (!events_.on_deadline_missed) return;
+          const auto it = keys_.find(handle);
+          if (it != keys_.end()) events_.on_deadline_missed(it->second);
+        });
     if (events_.deadline_misses) *events_.deadline_misses += missed;
-    for (const Msg& key : missed_keys) events_.on_deadline_missed(key);
   }
 
   OnSample on_sample_;
@@ -274,6 +284,7 @@ class Participant {
                        nullptr);
   }
   // A reader with a listener of the caller's, which must outlive the handle (declared before it).
+  // The topic's deadline (spec.deadline_ns) is the listener's to keep: this keeps none.
   template <class PubSubType>
   [[nodiscard]] Reader reader(const TopicSpec& spec, eprosima::fastdds::dds::DataReaderListener* listener) {
     return make_reader(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.reader_profile,

@@ -17,8 +17,8 @@ struct TopicSpec {
   std::int64_t deadline_ns = 0;
 };
 
-// Two 200 ms beacon slots: a gateway whose TOFs (or the decoder whose ranges) stopped is noticed
-// within two slots.
+// Two 200 ms beacon slots (under three of seed 002's 150 ms pulse slots): a gateway whose TOFs or
+// pulses (or the decoder whose ranges) stopped is noticed within two slots.
 inline constexpr std::int64_t kBeaconMeasurementDeadlineNs = 400'000'000;
 // Five 10 ms odometry periods: odometry stopping is a fault to report quickly.
 inline constexpr std::int64_t kOdometryDeadlineNs = 50'000'000;
