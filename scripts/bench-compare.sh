@@ -17,21 +17,8 @@ cd "$(dirname "$0")/.."
 base=${1:-HEAD~1}
 rounds=${2:-4}
 filter=${3:-.}
-base_sha=$(git rev-parse --short=10 "$base^{commit}")
-tree=build/compare/$base_sha
-if [ ! -d "$tree" ]; then
-  mkdir -p build/compare
-  git worktree add --detach "$tree" "$base_sha" >/dev/null
-fi
-# The base tree needs ../shared beside it, as the repository does.
-[ -e build/compare/shared ] || ln -s "$(cd .. && pwd)/shared" build/compare/shared
-configure() {
-  cmake -S "$1" -B "$2" -G Ninja -DCMAKE_BUILD_TYPE=Release -DBEACONLOC_WERROR=ON \
-    -DBEACONLOC_BUILD_BENCHMARKS=ON >/dev/null
-  cmake --build "$2" -j 2 --target beaconloc_benchmarks
-}
-configure "$tree" "$tree/build"
-configure . build/release
+. scripts/compare-trees.sh
+build_both_trees "$base" beaconloc_benchmarks
 before="$tree/build/benchmarks/beaconloc_benchmarks"
 after=build/release/benchmarks/beaconloc_benchmarks
 out=build/compare/$base_sha-results

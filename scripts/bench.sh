@@ -7,7 +7,8 @@
 #
 #   --quick    every benchmark briefly, to check that it runs (CI); not figures to quote.
 #   --repeat   repetitions of each multi-process case (default 3); medians are over them.
-#   --robots   robot counts of the fleet sweep (default "50 100 125 150 175 200 500").
+#   --robots   robot counts of the fleet sweep (default "100 200 250 300 350 400 500"); each count
+#              runs the localizer and, in turn, the bare Fast DDS relay (--bare) as its yardstick.
 #   --out      output directory (default build/bench): results.csv (every run), medians.csv.
 #
 # Each multi-process benchmark leases its own DDS domain (tests/support/domain_id.hpp) and uses
@@ -17,7 +18,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 quick=0
 repeat=3
-robots="50 100 125 150 175 200 500"
+robots="100 200 250 300 350 400 500"
 out=build/bench
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -78,15 +79,18 @@ else
   "$bin/latency/beaconloc_latency" --repeat "$repeat" --duration-s 40 --csv "$csv"
 fi
 
-# 3. Robots served by one localizer process.
+# 3. Robots served by one localizer process, and by the bare Fast DDS relay standing in for it
+#    (the middleware's own cost of the same samples), in turn.
 echo "== robots per machine"
 for n in $robots; do
   for ((i = 1; i <= repeat; i++)); do
-    if [ "$quick" = 1 ]; then
-      "$bin/fleet/beaconloc_fleet_benchmark" --robots "$n" --warmup-s 2 --window-s 3 --csv "$csv"
-    else
-      "$bin/fleet/beaconloc_fleet_benchmark" --robots "$n" --warmup-s 5 --window-s 10 --csv "$csv"
-    fi
+    for bare in "" --bare; do
+      if [ "$quick" = 1 ]; then
+        "$bin/fleet/beaconloc_fleet_benchmark" --robots "$n" --warmup-s 2 --window-s 3 $bare --csv "$csv"
+      else
+        "$bin/fleet/beaconloc_fleet_benchmark" --robots "$n" --warmup-s 5 --window-s 10 $bare --csv "$csv"
+      fi
+    done
   done
 done
 

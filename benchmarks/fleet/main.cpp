@@ -4,7 +4,8 @@
 // fleet_feeder.cpp) writing the beacon map, 100 Hz odometry and the TOFs of every robot (3
 // receivers x 5 Hz slots = 15 TOF/s each), `beaconloc decoder`, and a pose sink (--role sink,
 // pose_sink.cpp) standing in for the robots' controllers: it counts the poses that arrive and
-// how old they are.
+// how old they are. With --bare, a bare Fast DDS relay takes the localizer's place (bare_relay.hpp):
+// the middleware's own cost of the same samples, the yardstick for the localizer's.
 //
 // Real time means: the sink gets >= 99 % of the odometry poses of the window (one per odometry
 // sample per robot), no odometry increment is lost, and the age of the poses does not grow.
@@ -33,6 +34,7 @@
 #include "beaconloc/dds/participant.hpp"
 #include "beaconloc/dds/topics.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
+#include "bare_relay.hpp"
 #include "bench_support.hpp"
 #include "domain_id.hpp"
 #include "fleet_feeder.hpp"
@@ -53,7 +55,8 @@ struct LocalizerSample {
   std::uint64_t poses = 0;
 };
 
-LocalizerSample sample(const LocalizerParticipant& localizer) {
+template <class Served>
+LocalizerSample sample(Served& localizer) {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   LocalizerSample s;
@@ -64,15 +67,25 @@ LocalizerSample sample(const LocalizerParticipant& localizer) {
   return s;
 }
 
-// The localizer role: runs the children, measures the window, prints.
-int run_localizer(const dds::DdsOptions& dds, const std::string& self, int robots, double warmup_s,
-                  double window_s, bool with_sink, const std::string& csv) {
-  const sim::Scenario scenario = sim::default_scenario();
-  EstimatorConfig config;
-  config.receivers = scenario.receivers;
-  const double rss_empty_mb = resident_mb(getpid());
-  LocalizerParticipant localizer(dds, LocalizerCore("range_ekf", config));
-  const double rss_participant_mb = resident_mb(getpid());
+struct Run {
+  dds::DdsOptions dds;
+  std::string self;  // this program, for the children
+  int robots = 0;
+  double warmup_s = 0.0, window_s = 0.0;
+  bool with_sink = true;
+  bool bare = false;
+  std::string csv;
+};
+
+// Runs the children around `localizer` (a LocalizerParticipant, or the BareRelay), measures the
+// window, prints.
+template <class Served>
+int measure(const Run& run, Served& localizer, double rss_empty_mb, double rss_participant_mb) {
+  const dds::DdsOptions& dds = run.dds;
+  const std::string& self = run.self;
+  const int robots = run.robots;
+  const double warmup_s = run.warmup_s, window_s = run.window_s;
+  const bool with_sink = run.with_sink;
 
   const double total_s = warmup_s + window_s;
   const StampNs window_from_ns = dds::wall_clock_ns() + s_to_ns(warmup_s + 1.0);
@@ -134,7 +147,8 @@ int run_localizer(const dds::DdsOptions& dds, const std::string& self, int robot
       feeder_exit == 0 && sink_exit == 0 && delivered && lost == 0.0 && lag_growth_ms < 50.0;
 
   const double cpu_pct = 100.0 * (end.cpu_s - begin.cpu_s) / window_s;
-  Results r(with_sink ? "fleet" : "fleet_no_sink", "robots=" + std::to_string(robots));
+  Results r(std::string(run.bare ? "fleet_bare_dds" : "fleet") + (with_sink ? "" : "_no_sink"),
+            "robots=" + std::to_string(robots));
   r.add("robots", robots, "count");
   r.add("localizer_cpu", cpu_pct, "%core");
   r.add("localizer_cpu_per_robot", cpu_pct / robots, "%core");
@@ -157,12 +171,26 @@ int run_localizer(const dds::DdsOptions& dds, const std::string& self, int robot
   r.add("sink_cpu", 100.0 * sink_cpu / window_s, "%core");
   r.add("real_time", real_time ? 1.0 : 0.0, "bool");
   r.print();
-  if (!csv.empty()) r.append_csv(csv);
+  if (!run.csv.empty()) r.append_csv(run.csv);
   if (real_time)
     std::filesystem::remove_all(dir);
   else
     std::printf("logs kept in %s\n", dir.c_str());
   return 0;
+}
+
+// The localizer role: the localizer (or, bare, the relay standing for it) and the window.
+int run_localizer(const Run& run) {
+  const double rss_empty_mb = resident_mb(getpid());
+  if (run.bare) {
+    BareRelay relay(run.dds);
+    return measure(run, relay, rss_empty_mb, resident_mb(getpid()));
+  }
+  const sim::Scenario scenario = sim::default_scenario();
+  EstimatorConfig config;
+  config.receivers = scenario.receivers;
+  LocalizerParticipant localizer(run.dds, LocalizerCore("range_ekf", config));
+  return measure(run, localizer, rss_empty_mb, resident_mb(getpid()));
 }
 
 }  // namespace
@@ -174,7 +202,7 @@ int main(int argc, char** argv) {
   int robots = 100;
   double warmup_s = 5.0, window_s = 15.0, seconds = 10.0;
   long long from_ns = 0, to_ns = 0;
-  bool no_sink = false;
+  bool no_sink = false, bare = false;
   beaconloc::dds::DdsOptions dds;
   dds.domain_id = 0;
   app.add_option("--role", role, "localizer (default; runs the others), feeder or sink")
@@ -193,6 +221,9 @@ int main(int argc, char** argv) {
   app.add_flag("--no-sink", no_sink,
                "no pose reader on this machine (the robots read their poses elsewhere): the localizer's "
                "own counts tell real time");
+  app.add_flag("--bare", bare,
+               "a bare Fast DDS relay in the localizer's place (bare_relay.hpp): the same samples in and "
+               "out, no estimator; the middleware's own cost of these rates");
   CLI11_PARSE(app, argc, argv);
   std::optional<beaconloc::testing::DomainLease> lease;
   if (dds.domain_id == 0) dds.domain_id = lease.emplace().id();
@@ -201,8 +232,8 @@ int main(int argc, char** argv) {
                                                        : std::vector<std::string>{});
     if (role == "feeder") return beaconloc::bench::run_feeder(dds, robots, seconds);
     if (role == "sink") return beaconloc::bench::run_sink(dds, from_ns, to_ns);
-    return beaconloc::bench::run_localizer(dds, beaconloc::bench::self_executable(), robots, warmup_s,
-                                           window_s, !no_sink, csv);
+    return beaconloc::bench::run_localizer(
+        {dds, beaconloc::bench::self_executable(), robots, warmup_s, window_s, !no_sink, bare, csv});
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fleet benchmark: %s\n", e.what());
     return 2;

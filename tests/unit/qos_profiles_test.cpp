@@ -91,5 +91,27 @@ TEST(QosProfiles, TheMeasurementLifespansAreTheHorizon) {
   EXPECT_EQ(checked, 4);  // raw_tof and beacon_range, writer and reader
 }
 
+// The robot-keyed topics' deadlines are their readers' (dds::TopicSpec::deadline_ns): a deadline
+// QoS in a profile would bring back Fast DDS 2.9's look through every robot's instance on each
+// sample, and be a second place for the same period.
+TEST(QosProfiles, NoProfileSetsADeadline) {
+  for (const char* file : {"/examples/qos/topics.xml", "/benchmarks/fleet/fleet_feeder_qos.xml"}) {
+    tinyxml2::XMLDocument doc;
+    const std::string path = std::string(BEACONLOC_SOURCE_DIR) + file;
+    ASSERT_EQ(doc.LoadFile(path.c_str()), tinyxml2::XML_SUCCESS) << path;
+    const tinyxml2::XMLElement* profiles = doc.RootElement()->FirstChildElement("profiles");
+    ASSERT_NE(profiles, nullptr) << path;
+    int profiles_read = 0;
+    for (const tinyxml2::XMLElement* e = profiles->FirstChildElement(); e; e = e->NextSiblingElement()) {
+      ++profiles_read;
+      const tinyxml2::XMLElement* qos = e->FirstChildElement("qos");
+      EXPECT_TRUE(!qos || !qos->FirstChildElement("deadline")) << path << ": " << e->Attribute("profile_name");
+    }
+    EXPECT_GT(profiles_read, 0) << path;
+  }
+  EXPECT_EQ(dds::kOdometryTopic.deadline_ns, 50 * kNsPerMillisecond);
+  EXPECT_EQ(dds::kRawTofTopic.deadline_ns, 2 * 200 * kNsPerMillisecond);  // two beacon slots
+}
+
 }  // namespace
 }  // namespace beaconloc

@@ -2,6 +2,7 @@
 // A DomainParticipant with its publisher and subscriber, created from the XML profiles, and the
 // owning handles (Writer, Reader) of the entities it creates. Thin: no logic beyond creating
 // entities with named QoS.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -27,7 +28,9 @@
 #include <utility>
 #include <vector>
 
+#include "beaconloc/core/deadline_watch.hpp"
 #include "beaconloc/dds/checked_type.hpp"
+#include "beaconloc/dds/periodic_task.hpp"
 #include "beaconloc/dds/topics.hpp"
 
 namespace beaconloc::dds {
@@ -52,7 +55,9 @@ void load_qos_profiles(const std::vector<std::string>& extra_files);
 // What a reader tells its participant besides samples (each member optional):
 template <class Msg>
 struct ReaderEvents {
-  std::atomic<std::uint64_t>* deadline_misses = nullptr;  // deadline QoS: an instance went quiet
+  // The topic's deadline (TopicSpec::deadline_ns) passed without a sample of an instance: the
+  // misses counted, once per period of silence.
+  std::atomic<std::uint64_t>* deadline_misses = nullptr;
   // The instance that missed its deadline, as a sample whose key fields are set (the robot id).
   std::function<void(const Msg& key)> on_deadline_missed;
   std::atomic<std::uint64_t>* writers_lost = nullptr;  // liveliness QoS: a writer died or hung
@@ -77,26 +82,52 @@ inline std::string writer_id(const eprosima::fastdds::dds::InstanceHandle_t& pub
   return s.str();
 }
 
-// Takes every valid sample a reader has and hands it to a callback with its SampleInfo; counts
-// missed deadlines and writers that lost liveliness, and tells which writers went away.
+// Takes every valid sample a reader has and hands it to a callback with its SampleInfo; keeps
+// the topic's deadline per instance (TopicSpec::deadline_ns: a DeadlineWatch checked on a thread
+// of its own about four times per period, so a miss is told 1-1.3 periods after the last sample
+// taken; a sample its lifespan dropped, or one that could not be decoded, does not count); counts
+// writers that lost liveliness, and tells which writers went away.
+// The misses are told under the watch's lock, so that a miss is never told after the sample that
+// ended it (on_sample runs after the sample renewed the deadline): a participant must not take,
+// inside on_deadline_missed, a lock under which it writes a topic it watches itself.
 template <class Msg>
 class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
  public:
   using OnSample = std::function<void(const Msg&, const eprosima::fastdds::dds::SampleInfo&)>;
-  SampleListener(OnSample on_sample, ReaderEvents<Msg> events)
-      : on_sample_(std::move(on_sample)), events_(std::move(events)) {}
+  // Throws std::logic_error when events ask for deadline misses of a topic without a deadline.
+  SampleListener(OnSample on_sample, ReaderEvents<Msg> events, std::int64_t deadline_ns)
+      : on_sample_(std::move(on_sample)), events_(std::move(events)) {
+    const bool deadline_asked = events_.deadline_misses || events_.on_deadline_missed;
+    if (deadline_asked && deadline_ns <= 0) {
+      throw std::logic_error("deadline misses asked of a reader whose topic has no deadline");
+    }
+    if (deadline_asked) {
+      watch_.emplace(deadline_ns);
+      const auto tick = std::max(std::chrono::milliseconds(1),
+                                 std::chrono::duration_cast<std::chrono::milliseconds>(
+                                     std::chrono::nanoseconds(deadline_ns / kDeadlineChecksPerPeriod)));
+      deadline_checks_ = std::make_unique<PeriodicTask>(tick, [this] { check_deadlines(); });
+    }
+  }
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
     Msg m;
     eprosima::fastdds::dds::SampleInfo info;
     while (reader->take_next_sample(&m, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) {
+        if (watch_) {
+          // Disposed, unregistered, or its writers gone: no longer watched, as the QoS drops an
+          // instance that is not alive (a dead gateway is told by liveliness instead).
+          std::lock_guard<std::mutex> lock(watch_mutex_);
+          watch_->forget(info.instance_handle);
+        }
         if (events_.on_instance_ended) events_.on_instance_ended(info);
         continue;
       }
-      if (events_.on_deadline_missed) {
+      if (watch_) {
         // Fast DDS 2.9's DataReader::get_key_value is unsupported: keep each instance's key.
-        std::lock_guard<std::mutex> lock(keys_mutex_);
-        if (!keys_.count(info.instance_handle)) keys_.emplace(info.instance_handle, m);
+        std::lock_guard<std::mutex> lock(watch_mutex_);
+        watch_->on_sample(info.instance_handle, steady_ns());
+        if (events_.on_deadline_missed) keys_.try_emplace(info.instance_handle, m);
       }
       on_sample_(m, info);
     }
@@ -105,19 +136,6 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
                                const eprosima::fastdds::dds::SubscriptionMatchedStatus& s) override {
     if (events_.on_writer_gone && s.current_count_change < 0) {
       events_.on_writer_gone(writer_id(s.last_publication_handle));
-    }
-  }
-  void on_requested_deadline_missed(eprosima::fastdds::dds::DataReader*,
-                                    const eprosima::fastdds::dds::RequestedDeadlineMissedStatus& s) override {
-    if (events_.deadline_misses) *events_.deadline_misses += static_cast<std::uint64_t>(s.total_count_change);
-    if (events_.on_deadline_missed) {
-      std::optional<Msg> key;
-      {
-        std::lock_guard<std::mutex> lock(keys_mutex_);
-        const auto it = keys_.find(s.last_instance_handle);
-        if (it != keys_.end()) key = it->second;
-      }
-      if (key) events_.on_deadline_missed(*key);
     }
   }
   void on_liveliness_changed(eprosima::fastdds::dds::DataReader*,
@@ -138,10 +156,29 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
   }
 
  private:
+  static constexpr int kDeadlineChecksPerPeriod = 4;
+  static std::int64_t steady_ns() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+  }
+  // On the checks' thread: the instances past their deadline, told under the watch's lock.
+  void check_deadlines() {
+    std::lock_guard<std::mutex> lock(watch_mutex_);
+    const std::uint64_t missed =
+        watch_->expire(steady_ns(), [&](const eprosima::fastdds::dds::InstanceHandle_t& handle) {
+          if (!events_.on_deadline_missed) return;
+          const auto it = keys_.find(handle);
+          if (it != keys_.end()) events_.on_deadline_missed(it->second);
+        });
+    if (events_.deadline_misses) *events_.deadline_misses += missed;
+  }
+
   OnSample on_sample_;
   ReaderEvents<Msg> events_;
-  std::mutex keys_mutex_;
+  std::mutex watch_mutex_;
+  std::optional<DeadlineWatch<eprosima::fastdds::dds::InstanceHandle_t>> watch_;  // with a deadline
   std::map<eprosima::fastdds::dds::InstanceHandle_t, Msg> keys_;  // a sample of each instance seen
+  std::unique_ptr<PeriodicTask> deadline_checks_;  // last: stops before what it uses goes
 };
 
 // Waits until every writer has at least one matched reader; false on timeout.
@@ -242,11 +279,12 @@ class Participant {
                                            typename SampleListener<typename PubSubType::type>::OnSample on_sample,
                                            ReaderEvents<typename PubSubType::type> events = {}) {
     return make_reader(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.reader_profile,
-                       std::make_unique<SampleListener<typename PubSubType::type>>(std::move(on_sample),
-                                                                                   std::move(events)),
+                       std::make_unique<SampleListener<typename PubSubType::type>>(
+                           std::move(on_sample), std::move(events), spec.deadline_ns),
                        nullptr);
   }
   // A reader with a listener of the caller's, which must outlive the handle (declared before it).
+  // The topic's deadline (spec.deadline_ns) is the listener's to keep: this keeps none.
   template <class PubSubType>
   [[nodiscard]] Reader reader(const TopicSpec& spec, eprosima::fastdds::dds::DataReaderListener* listener) {
     return make_reader(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.reader_profile,

@@ -1,19 +1,36 @@
 #pragma once
-// DDS topic names of the beaconloc bus and the QoS profile of each (examples/qos/topics.xml).
+// DDS topic names of the beaconloc bus, the QoS profile of each (examples/qos/topics.xml), and
+// the deadline its readers keep.
+#include <cstdint>
+
 namespace beaconloc::dds {
 
 struct TopicSpec {
   const char* name;
   const char* writer_profile;
   const char* reader_profile;
+  // How long a robot may go without a sample before the reader reports a missed deadline (0:
+  // never). Kept by the reader (SampleListener, core/deadline_watch.hpp), not by the deadline
+  // QoS: Fast DDS 2.9 looks through every robot's instance on each sample of a keyed topic with
+  // a deadline, which made a localizer's cost per sample grow with the fleet (BENCHMARKS.md
+  // section 3). The profiles in topics.xml therefore set no deadline.
+  std::int64_t deadline_ns = 0;
 };
 
-inline constexpr TopicSpec kRawTofTopic{"beaconloc/raw_tof", "raw_tof.writer", "raw_tof.reader"};
+// Two 200 ms beacon slots (under three of seed 002's 150 ms pulse slots): a gateway whose TOFs or
+// pulses (or the decoder whose ranges) stopped is noticed within two slots.
+inline constexpr std::int64_t kBeaconMeasurementDeadlineNs = 400'000'000;
+// Five 10 ms odometry periods: odometry stopping is a fault to report quickly.
+inline constexpr std::int64_t kOdometryDeadlineNs = 50'000'000;
+
+inline constexpr TopicSpec kRawTofTopic{"beaconloc/raw_tof", "raw_tof.writer", "raw_tof.reader",
+                                        kBeaconMeasurementDeadlineNs};
 inline constexpr TopicSpec kPulseArrivalTopic{"beaconloc/pulse_arrival", "pulse_arrival.writer",
-                                              "pulse_arrival.reader"};
+                                              "pulse_arrival.reader", kBeaconMeasurementDeadlineNs};
 inline constexpr TopicSpec kBeaconRangeTopic{"beaconloc/beacon_range", "beacon_range.writer",
-                                             "beacon_range.reader"};
-inline constexpr TopicSpec kOdometryTopic{"beaconloc/odometry", "odometry.writer", "odometry.reader"};
+                                             "beacon_range.reader", kBeaconMeasurementDeadlineNs};
+inline constexpr TopicSpec kOdometryTopic{"beaconloc/odometry", "odometry.writer", "odometry.reader",
+                                          kOdometryDeadlineNs};
 inline constexpr TopicSpec kLaserScanTopic{"beaconloc/laser_scan", "laser_scan.writer", "laser_scan.reader"};
 inline constexpr TopicSpec kPoseEstimateTopic{"beaconloc/pose_estimate", "pose_estimate.writer",
                                               "pose_estimate.reader"};
