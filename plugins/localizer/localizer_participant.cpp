@@ -12,14 +12,6 @@
 
 namespace beaconloc {
 
-namespace {
-StampNs steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-}  // namespace
-
 template <class PubSubType, class Fuse>
 void LocalizerParticipant::subscribe_beacon_measurements(const dds::TopicSpec& topic, Fuse fuse) {
   using Msg = typename PubSubType::type;
@@ -183,11 +175,11 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
   dds::ReaderEvents<msg::Diagnostics> peer_events;
   peer_events.on_writer_gone = [this](const std::string& writer) {
     std::lock_guard<std::mutex> lock(mutex_);
-    conflicts_.on_peer_gone(writer, steady_ns());
+    conflicts_.on_peer_gone(writer, dds::steady_clock_ns());
   };
   peer_events.on_instance_ended = [this](const eprosima::fastdds::dds::SampleInfo& info) {
     std::lock_guard<std::mutex> lock(mutex_);
-    conflicts_.on_peer_gone(dds::writer_id(info.publication_handle), steady_ns());
+    conflicts_.on_peer_gone(dds::writer_id(info.publication_handle), dds::steady_clock_ns());
   };
   readers_.push_back(participant_.subscribe_with_info<msg::DiagnosticsPubSubType>(
       dds::kDiagnosticsTopic,
@@ -205,7 +197,7 @@ void LocalizerParticipant::on_peer_diagnostics(const msg::Diagnostics& d, const 
     return;
   }
   conflicts_.on_peer_report(writer, d.participant(),
-                            {d.robots_localized().begin(), d.robots_localized().end()}, steady_ns());
+                            {d.robots_localized().begin(), d.robots_localized().end()}, dds::steady_clock_ns());
 }
 
 void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
@@ -254,7 +246,7 @@ void LocalizerParticipant::publish_firing_plan(const std::string& robot_id, Stam
 
 void LocalizerParticipant::publish(const LocalizerOutput& out) {
   if (core_.robot_count() != robots_told_) {  // a new robot: is it contested? (once per robot)
-    conflicts_.set_own_robots(core_.robot_ids(), steady_ns());
+    conflicts_.set_own_robots(core_.robot_ids(), dds::steady_clock_ns());
     robots_told_ = core_.robot_count();
   }
   PoseEstimate estimate = out.estimate;
@@ -300,7 +292,7 @@ void LocalizerParticipant::share_calibration() {
 msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::string> robots = core_.robot_ids();
-  conflicts_.set_own_robots(robots, steady_ns());  // and drops the peers gone silent
+  conflicts_.set_own_robots(robots, dds::steady_clock_ns());  // and drops the peers gone silent
   const PoseStatus worst = core_.worst_status();
   msg::ParticipantStatus status = msg::PARTICIPANT_STATUS_OK;
   std::string message =

@@ -32,6 +32,7 @@
 #include "beaconloc/dds/checked_type.hpp"
 #include "beaconloc/dds/periodic_task.hpp"
 #include "beaconloc/dds/topics.hpp"
+#include "beaconloc/dds/wall_clock.hpp"
 
 namespace beaconloc::dds {
 
@@ -126,7 +127,7 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
       if (watch_) {
         // Fast DDS 2.9's DataReader::get_key_value is unsupported: keep each instance's key.
         std::lock_guard<std::mutex> lock(watch_mutex_);
-        watch_->on_sample(info.instance_handle, steady_ns());
+        watch_->on_sample(info.instance_handle, steady_clock_ns());
         if (events_.on_deadline_missed) keys_.try_emplace(info.instance_handle, m);
       }
       on_sample_(m, info);
@@ -157,15 +158,11 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
 
  private:
   static constexpr int kDeadlineChecksPerPeriod = 4;
-  static std::int64_t steady_ns() {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-  }
   // On the checks' thread: the instances past their deadline, told under the watch's lock.
   void check_deadlines() {
     std::lock_guard<std::mutex> lock(watch_mutex_);
     const std::uint64_t missed =
-        watch_->expire(steady_ns(), [&](const eprosima::fastdds::dds::InstanceHandle_t& handle) {
+        watch_->expire(steady_clock_ns(), [&](const eprosima::fastdds::dds::InstanceHandle_t& handle) {
           if (!events_.on_deadline_missed) return;
           const auto it = keys_.find(handle);
           if (it != keys_.end()) events_.on_deadline_missed(it->second);

@@ -1,5 +1,6 @@
 #pragma once
-// The participants' clock (never the core's): system time in int64 ns, for stamping live data.
+// The participants' clocks (never the core's), in int64 ns: system time for stamping live data,
+// the steady clock for how long something has been silent.
 #include <chrono>
 
 #include "beaconloc/core/time.hpp"
@@ -9,6 +10,12 @@ namespace beaconloc::dds {
 inline StampNs wall_clock_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+inline StampNs steady_clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
