@@ -2,6 +2,8 @@
 
 #include <beaconlocPubSubTypes.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 
@@ -30,8 +32,10 @@ void LocalizerParticipant::subscribe_beacon_measurements(const dds::TopicSpec& t
           // Written under the lock, as every pose is, so that a robot's poses go out in stamp
           // order: a correction at once, not with the next odometry sample.
           std::lock_guard<std::mutex> lock(mutex_);
-          if (auto corrected = fuse(m)) publish(*corrected);
-          share_calibration();
+          if (serves(m.robot_id())) {
+            if (auto corrected = fuse(m)) publish(*corrected);
+            share_calibration();
+          }
         }
         ++ranges_processed_;
       },
@@ -51,6 +55,20 @@ std::optional<BeaconCalibration> kept_calibration(const std::string& path) {
   }
   return kept;
 }
+
+// A shard's participant name tells the shards apart in the Diagnostics (the monitor, a peer's
+// serving conflicts): the host and the process.
+std::string participant_name(const std::string& estimator, bool shard) {
+  std::string name = "beaconloc.localizer." + estimator;
+  if (!shard) return name;
+  char host[256] = {};
+  if (gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+  return name + ".shard." + (host[0] ? host : "unknown-host") + "." + std::to_string(getpid());
+}
+
+// How often a shard asserts its announcement's liveliness: five times a lease (topics.xml), so
+// that a shard stalled for most of a lease by a busy machine keeps its robots.
+constexpr int kShardAssertionsPerLease = 5;
 }  // namespace
 
 LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core,
@@ -58,13 +76,14 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
     : core_(std::move(core)),
       conflicts_(std::chrono::duration_cast<std::chrono::nanoseconds>(dds::kDiagnosticsSilentAfter).count()),
       options_(std::move(options)),
-      participant_(dds, "beaconloc.localizer." + core_.estimator_name()),
+      participant_(dds, participant_name(core_.estimator_name(), options_.shard)),
       pose_writer_(participant_.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic)),
       state_writer_(participant_.writer<msg::EstimatorStatePubSubType>(dds::kEstimatorStateTopic)),
       calibration_writer_(participant_.writer<msg::BeaconCalibrationPubSubType>(dds::kBeaconCalibrationTopic)),
       plan_writer_(options_.selective_activation ? participant_.writer<msg::FiringPlanPubSubType>(dds::kFiringPlanTopic)
                                                  : dds::Writer()) {
   own_calibration_writer_ = dds::writer_id(calibration_writer_->get_instance_handle());
+  if (options_.shard) announce_shard();  // before the first sample, which it may not serve
   if (!options_.calibration_file.empty() && !core_.uses_calibration()) {
     throw CalibrationFileError("calibration file " + options_.calibration_file + ": the estimator " +
                                core_.estimator_name() + " uses no beacon calibration");
@@ -157,6 +176,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
   if (core_.uses_laser()) {
     readers_.push_back(participant_.subscribe<msg::LaserScanPubSubType>(dds::kLaserScanTopic, [this](const msg::LaserScan& m) {
       std::lock_guard<std::mutex> lock(mutex_);
+      if (!serves(m.robot_id())) return;
       if (auto corrected = core_.on_laser(m.robot_id(), dds::from_msg(m))) publish(*corrected);
       share_calibration();
     }));
@@ -166,6 +186,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
         Cov3 c;
         for (int i = 0; i < 9; ++i) c(i / 3, i % 3) = m.covariance()[static_cast<std::size_t>(i)];
         std::lock_guard<std::mutex> lock(mutex_);
+        if (!serves(m.robot_id())) return;
         core_.on_initial_pose(m.robot_id(), m.stamp_ns(), Pose2(m.x_m(), m.y_m(), m.yaw_rad()), c);
       }));
   diagnostics_ =
@@ -187,6 +208,80 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
         on_peer_diagnostics(d, dds::writer_id(info.publication_handle));
       },
       peer_events));
+  if (options_.shard) listen_to_shards();  // after diagnostics_, which a change of shards publishes
+}
+
+bool LocalizerParticipant::serves(const std::string& robot_id) {
+  if (!shard_ || shard_->serves(robot_id, dds::steady_clock_ns())) return true;
+  ++other_shard_samples_;
+  return false;
+}
+
+void LocalizerParticipant::announce_shard() {
+  shard_writer_ = participant_.writer<msg::LocalizerShardPubSubType>(dds::kLocalizerShardTopic);
+  const std::string self = dds::writer_id(shard_writer_->get_instance_handle());
+  shard_.emplace(self, core_.estimator_name(), dds::steady_clock_ns(), kShardSettleNs);
+  msg::LocalizerShard m;
+  m.shard(self);
+  m.participant(participant_.name());
+  m.estimator(core_.estimator_name());
+  shard_writer_->write(&m);
+  const eprosima::fastrtps::Duration_t lease = shard_writer_->get_qos().liveliness().lease_duration;
+  const auto lease_ms = std::chrono::milliseconds(static_cast<std::int64_t>(lease.seconds) * 1000 + lease.nanosec / 1'000'000);
+  shard_liveliness_ = std::make_unique<dds::PeriodicTask>(lease_ms / kShardAssertionsPerLease, [this] {
+    // Only a localizer that can take its lock asserts: one stuck under it (a hung estimator) is
+    // taken for gone, and its robots served by the others. Asserted outside the lock: Fast DDS
+    // may tell its own reader at once, whose callback takes the lock.
+    { std::lock_guard<std::mutex> lock(mutex_); }
+    shard_writer_->assert_liveliness();
+  });
+}
+
+void LocalizerParticipant::listen_to_shards() {
+  // Each event under the lock; a change of the live shards hands robots over at once and says so
+  // in the Diagnostics at once, so that the shard taking a robot over does not see it listed by
+  // this one for up to a period (a serving conflict).
+  auto changed = [this](auto change) {
+    bool moved = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      moved = change();
+      if (moved) hand_over_robots();
+    }
+    if (moved) diagnostics_->publish_now();
+  };
+  dds::ReaderEvents<msg::LocalizerShard> events;
+  events.on_writer_gone = [this, changed](const std::string& writer) {
+    changed([&] {
+      const bool moved = shard_->on_shard_gone(writer);
+      // Its Diagnostics may go on listing its robots for seconds (a killed process's last report):
+      // not a conflict with the shard taking them over.
+      if (moved) conflicts_.on_peers_gone(dds::participant_of_writer(writer), dds::steady_clock_ns());
+      return moved;
+    });
+  };
+  events.on_writer_alive = [this, changed](const std::string& writer) {
+    changed([&] { return shard_->on_shard_alive(writer); });
+  };
+  readers_.push_back(participant_.subscribe_with_info<msg::LocalizerShardPubSubType>(
+      dds::kLocalizerShardTopic,
+      [this, changed](const msg::LocalizerShard& m, const eprosima::fastdds::dds::SampleInfo& info) {
+        changed([&] { return shard_->on_announcement(dds::writer_id(info.publication_handle), m.estimator()); });
+      },
+      events));
+}
+
+void LocalizerParticipant::hand_over_robots() {
+  const StampNs now_ns = dds::steady_clock_ns();
+  for (const std::string& robot_id : core_.robot_ids()) {
+    if (shard_->serves(robot_id, now_ns)) continue;
+    core_.release_robot(robot_id);
+    odometry_sequence_.erase(robot_id);
+    plan_sent_ns_.erase(robot_id);
+    ++robots_handed_over_;
+  }
+  conflicts_.set_own_robots(core_.robot_ids(), now_ns);
+  robots_told_ = core_.robot_count();
 }
 
 void LocalizerParticipant::on_peer_diagnostics(const msg::Diagnostics& d, const std::string& writer) {
@@ -203,30 +298,34 @@ void LocalizerParticipant::on_peer_diagnostics(const msg::Diagnostics& d, const 
 void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    // Increments the bus dropped (a history too short for a stalled reader): counted, since an
-    // estimator integrating odometry cannot see that a 10 ms step is missing.
-    if (core_.serves(m.robot_id())) {
-      auto [last, first] = odometry_sequence_.try_emplace(m.robot_id(), m.sequence_number());
-      const std::uint64_t seq = m.sequence_number();
-      const std::uint64_t distance = seq > last->second ? seq - last->second : last->second - seq;
-      if (!first && distance > kSequenceRestart) {
-        // Far back (a restarted gateway numbering from 0 again) or far ahead (another writer, a
-        // corrupted number): a new numbering, not that many lost samples.
-        last->second = seq;
-        ++sequence_restarts_;
-      } else if (!first && seq > last->second) {
-        lost_increments_ += seq - last->second - 1;
-        last->second = seq;
-      }
-    }
-    if (auto out = core_.on_odometry(m.robot_id(), dds::from_msg(m))) {
-      publish(*out);
-      publish_firing_plan(m.robot_id(), out->estimate.stamp_ns);
-    }
-    share_calibration();
+    if (serves(m.robot_id())) fuse_odometry(m);
     newest_odometry_stamp_ns_ = std::max(newest_odometry_stamp_ns_.load(), m.stamp_ns());
   }
   ++odometry_processed_;
+}
+
+void LocalizerParticipant::fuse_odometry(const msg::Odometry& m) {
+  // Increments the bus dropped (a history too short for a stalled reader): counted, since an
+  // estimator integrating odometry cannot see that a 10 ms step is missing.
+  if (core_.serves(m.robot_id())) {
+    auto [last, first] = odometry_sequence_.try_emplace(m.robot_id(), m.sequence_number());
+    const std::uint64_t seq = m.sequence_number();
+    const std::uint64_t distance = seq > last->second ? seq - last->second : last->second - seq;
+    if (!first && distance > kSequenceRestart) {
+      // Far back (a restarted gateway numbering from 0 again) or far ahead (another writer, a
+      // corrupted number): a new numbering, not that many lost samples.
+      last->second = seq;
+      ++sequence_restarts_;
+    } else if (!first && seq > last->second) {
+      lost_increments_ += seq - last->second - 1;
+      last->second = seq;
+    }
+  }
+  if (auto out = core_.on_odometry(m.robot_id(), dds::from_msg(m))) {
+    publish(*out);
+    publish_firing_plan(m.robot_id(), out->estimate.stamp_ns);
+  }
+  share_calibration();
 }
 
 void LocalizerParticipant::publish_firing_plan(const std::string& robot_id, StampNs stamp_ns) {
@@ -325,6 +424,16 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   if (core_.beacon_map_changes()) {
     message += "; beacon map replaced " + std::to_string(core_.beacon_map_changes()) +
                " time(s), every robot restarted on it";
+  }
+  if (shard_) {
+    const StampNs now_ns = dds::steady_clock_ns();
+    message += "; shard: " + std::to_string(shard_->live_shards()) + " live shard(s) of " + core_.estimator_name() +
+               (shard_->settled(now_ns) ? "" : ", settling (serving none yet)") + ", " +
+               std::to_string(robots_handed_over_) + " robot(s) handed over, " +
+               std::to_string(other_shard_samples_) + " sample(s) of other shards' robots";
+    if (shard_->other_estimator_shards()) {
+      message += ", " + std::to_string(shard_->other_estimator_shards()) + " shard(s) of other estimators";
+    }
   }
   if (plan_writer_) message += "; selective activation: " + std::to_string(plans_sent_) + " firing plan(s) sent";
   if (!core_.calibration().groups.empty()) {

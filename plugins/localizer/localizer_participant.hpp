@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "beaconloc/dds/participant.hpp"
 #include "localizer_core.hpp"
 #include "serving_conflicts.hpp"
+#include "shard_membership.hpp"
 
 namespace beaconloc {
 
@@ -33,6 +35,11 @@ struct LocalizerParticipantOptions {
   // that may reach the robot (LocalizerCore::firing_plan), every kFiringPlanPeriodNs of data time
   // while the robot has a pose. Off: the gateways fire every beacon.
   bool selective_activation = false;
+  // A shard of a fleet's localizers (issue 19): it announces itself on localizer_shard and
+  // serves only the robots that ShardAssignment gives it among the live shards of its
+  // estimator, taking over the robots of a shard that dies or hangs (liveliness, 0.5 s) and
+  // handing robots to a shard that joins. Off: it serves every robot (or --robot's one).
+  bool shard = false;
 };
 
 // A calibration file that exists and cannot be used: the start is refused, with the reason.
@@ -67,9 +74,18 @@ class LocalizerParticipant {
  private:
   msg::Diagnostics diagnostics_snapshot();
   void on_odometry(const msg::Odometry& odometry);
+  void fuse_odometry(const msg::Odometry& odometry);  // a robot it serves, under mutex_
   void publish(const LocalizerOutput& out);  // under mutex_
   void publish_firing_plan(const std::string& robot_id, StampNs stamp_ns);  // under mutex_
   void on_peer_diagnostics(const msg::Diagnostics& d, const std::string& writer);
+  // Shards: whether this localizer serves the robot now (always, unless a shard); a sample of a
+  // robot another shard serves is counted and dropped. Under mutex_.
+  bool serves(const std::string& robot_id);
+  // Shards: announces this one and starts keeping its liveliness; then listens to the others.
+  void announce_shard();
+  void listen_to_shards();
+  // After the live shards changed (under mutex_): releases the robots another shard serves now.
+  void hand_over_robots();
   // The site's calibration, when it changed (a robot calibrated a group, another localizer's
   // arrived): on the bus, and into the calibration file. Under mutex_.
   void share_calibration();
@@ -109,14 +125,19 @@ class LocalizerParticipant {
   std::string calibration_save_error_;             // the last failure, while the newest is unsaved
   std::map<std::string, StampNs> plan_sent_ns_;    // stamp of the pose each robot's last plan came from
   std::uint64_t plans_sent_ = 0;
+  std::optional<ShardMembership> shard_;      // with options_.shard
+  std::uint64_t other_shard_samples_ = 0;     // samples of robots another shard serves
+  std::uint64_t robots_handed_over_ = 0;      // robots released to another shard
   // The entities, owned: the readers, declared last, stop first, before what they use goes.
   dds::Participant participant_;
   dds::Writer pose_writer_;
   dds::Writer state_writer_;  // EstimatorState: what the estimator holds beside the pose
   dds::Writer calibration_writer_;  // BeaconCalibration: the site's calibrated beacon groups
   dds::Writer plan_writer_;         // FiringPlan, with selective activation
+  dds::Writer shard_writer_;        // LocalizerShard, with options_.shard
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
   std::vector<dds::Reader> readers_;
+  std::unique_ptr<dds::PeriodicTask> shard_liveliness_;  // asserts shard_writer_'s; stops first
 };
 
 }  // namespace beaconloc

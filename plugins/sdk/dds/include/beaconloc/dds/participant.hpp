@@ -68,6 +68,9 @@ struct ReaderEvents {
   // A writer of the topic is gone: unmatched (deleted, its participant left or was lost) or its
   // liveliness lost; the id is writer_id() of its samples' SampleInfo::publication_handle.
   std::function<void(const std::string& writer)> on_writer_gone;
+  // A writer's liveliness is asserted again: after its loss (a stall longer than the lease), and
+  // when it is first matched.
+  std::function<void(const std::string& writer)> on_writer_alive;
   // A sample without data: its writer disposed or unregistered the instance (info.instance_state).
   std::function<void(const eprosima::fastdds::dds::SampleInfo& info)> on_instance_ended;
 };
@@ -82,6 +85,9 @@ inline std::string writer_id(const eprosima::fastdds::dds::InstanceHandle_t& pub
   }
   return s.str();
 }
+
+// The participant a writer belongs to, from writer_id(): its GUID prefix (the first 12 of 16 octets).
+inline std::string participant_of_writer(const std::string& writer) { return writer.substr(0, 24); }
 
 // Takes every valid sample a reader has and hands it to a callback with its SampleInfo; keeps
 // the topic's deadline per instance (TopicSpec::deadline_ns: a DeadlineWatch checked on a thread
@@ -153,6 +159,9 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
     }
     if (events_.on_writer_gone && s.not_alive_count_change > 0) {
       events_.on_writer_gone(writer_id(s.last_publication_handle));
+    }
+    if (events_.on_writer_alive && s.alive_count_change > 0) {
+      events_.on_writer_alive(writer_id(s.last_publication_handle));
     }
   }
 
