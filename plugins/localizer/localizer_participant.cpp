@@ -430,7 +430,7 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
     message += "; shard: " + std::to_string(shard_->live_shards()) + " live shard(s) of " + core_.estimator_name() +
                (shard_->settled(now_ns) ? "" : ", settling (serving none yet)") + ", " +
                std::to_string(robots_handed_over_) + " robot(s) handed over, " +
-               std::to_string(other_shard_samples_) + " sample(s) of other shards' robots";
+               std::to_string(other_shard_samples_) + " sample(s) of robots it does not serve (other shards', or while settling)";
     if (shard_->other_estimator_shards()) {
       message += ", " + std::to_string(shard_->other_estimator_shards()) + " shard(s) of other estimators";
     }

@@ -126,7 +126,7 @@ class LocalizerParticipant {
   std::map<std::string, StampNs> plan_sent_ns_;    // stamp of the pose each robot's last plan came from
   std::uint64_t plans_sent_ = 0;
   std::optional<ShardMembership> shard_;      // with options_.shard
-  std::uint64_t other_shard_samples_ = 0;     // samples of robots another shard serves
+  std::uint64_t other_shard_samples_ = 0;     // samples of robots it does not serve (serves())
   std::uint64_t robots_handed_over_ = 0;      // robots released to another shard
   // The entities, owned: the readers, declared last, stop first, before what they use goes.
   dds::Participant participant_;

@@ -1,0 +1,145 @@
+#pragma once
+// What the shard tests watch (integration.Shards, multihost.*): the live localizer shards as their
+// announcements tell, which shard the assignment gives each robot, and which one its poses come
+// from.
+#include <beaconlocPubSubTypes.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "beaconloc/core/shard_assignment.hpp"
+#include "beaconloc/dds/participant.hpp"
+#include "pose_recorder.hpp"
+#include "process.hpp"
+
+namespace beaconloc::testing {
+
+using Clock = std::chrono::steady_clock;
+
+// The live shards, as their announcements (LocalizerShard) and its liveliness tell.
+class ShardWatcher {
+ public:
+  explicit ShardWatcher(const dds::DdsOptions& dds) : participant_(dds, "beaconloc.test.shards") {
+    dds::ReaderEvents<msg::LocalizerShard> events;
+    events.on_writer_gone = [this](const std::string& writer) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      live_.erase(writer);
+    };
+    reader_ = participant_.subscribe_with_info<msg::LocalizerShardPubSubType>(
+        dds::kLocalizerShardTopic,
+        [this](const msg::LocalizerShard&, const eprosima::fastdds::dds::SampleInfo& info) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          live_.insert(dds::writer_id(info.publication_handle));
+        },
+        events);
+  }
+  std::set<std::string> live() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return live_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::set<std::string> live_;  // announcement writer ids
+  dds::Participant participant_;
+  dds::Reader reader_;
+};
+
+// robot -> the participant (dds::participant_of_writer) that should serve it among `shards`.
+inline std::map<std::string, std::string> expected_owners(const std::set<std::string>& shards,
+                                                   const std::vector<std::string>& robots) {
+  ShardAssignment assignment(*shards.begin());
+  assignment.set_live({shards.begin(), shards.end()});
+  std::map<std::string, std::string> out;
+  for (const std::string& robot : robots) out[robot] = dds::participant_of_writer(assignment.owner(robot));
+  return out;
+}
+
+// Whether every robot's newest pose came from the participant the assignment gives it.
+inline bool served_as_assigned(const PoseRecorder& poses, const std::map<std::string, std::string>& owners) {
+  const auto robots = poses.robots();
+  return std::all_of(owners.begin(), owners.end(), [&](const auto& robot_owner) {
+    const auto it = robots.find(robot_owner.first);
+    return it != robots.end() && it->second.newest &&
+           dds::participant_of_writer(it->second.newest->writer) == robot_owner.second;
+  });
+}
+
+// The writers of a robot's poses in turn: "participant from +t s" (since `since`), for a failure.
+inline std::string writer_turns(const PoseRecorder& poses, const std::string& robot, Clock::time_point since) {
+  std::string out, writer;
+  for (const RecordedPose& p : poses.poses()) {
+    if (p.row.robot_id != robot || p.writer == writer) continue;
+    writer = p.writer;
+    out += "\n  " + dds::participant_of_writer(writer) + " from " +
+           std::to_string(std::chrono::duration<double>(p.received - since).count()) + " s";
+  }
+  return out;
+}
+
+// The first pose of robot, received at or after `since`, from `participant`'s writer (ok ones alone
+// with ok_only): seconds after `since`.
+inline std::optional<double> first_pose_from(const PoseRecorder& poses, const std::string& robot,
+                                             const std::string& participant, Clock::time_point since,
+                                             bool ok_only) {
+  std::optional<double> first;
+  for (const RecordedPose& p : poses.poses()) {
+    if (p.row.robot_id != robot || p.received < since || dds::participant_of_writer(p.writer) != participant) continue;
+    if (ok_only && p.row.estimate.status != PoseStatus::kOk) continue;
+    const double s = std::chrono::duration<double>(p.received - since).count();
+    if (!first || s < *first) first = s;
+  }
+  return first;
+}
+
+// Starts a shard (start) and waits for its announcement; `running` keeps it by its participant id,
+// which is returned ("" with a test failure when it never announces itself).
+inline std::string start_shard(const ShardWatcher& shards, const std::function<std::unique_ptr<ChildProcess>()>& start,
+                               std::map<std::string, std::unique_ptr<ChildProcess>>& running) {
+  using namespace std::chrono_literals;
+  const std::set<std::string> before = shards.live();
+  std::unique_ptr<ChildProcess> shard = start();
+  std::string id;
+  EXPECT_TRUE(eventually(
+      [&] {
+        for (const std::string& s : shards.live()) {
+          if (!before.count(s)) id = dds::participant_of_writer(s);
+        }
+        return !id.empty();
+      },
+      20s))
+      << "a shard never announced itself:\n"
+      << shard->log();
+  if (!id.empty()) running[id] = std::move(shard);
+  return id;
+}
+
+// The robots of a shard killed at `killed`, each served again by the shard `owners` now gives it:
+// prints how long after the kill its first pose and its first ok pose came, and expects the first
+// within issue 19's 2 s (scaled() under the sanitizers).
+inline void expect_taken_over_within_2s(const PoseRecorder& poses, const std::vector<std::string>& robots,
+                                        const std::map<std::string, std::string>& owners, Clock::time_point killed) {
+  using namespace std::chrono_literals;
+  for (const std::string& robot : robots) {
+    const std::string& owner = owners.at(robot);
+    EXPECT_TRUE(eventually([&] { return first_pose_from(poses, robot, owner, killed, true).has_value(); }, 10s))
+        << robot << " not served again after its shard was killed";
+    const auto first = first_pose_from(poses, robot, owner, killed, false);
+    const auto first_ok = first_pose_from(poses, robot, owner, killed, true);
+    if (!first || !first_ok) continue;
+    std::printf("takeover: %s served again %.2f s after its shard was killed, ok %.2f s after\n", robot.c_str(),
+                *first, *first_ok);
+    EXPECT_LE(*first, std::chrono::duration<double>(scaled(2000ms)).count()) << robot;
+  }
+}
+
+}  // namespace beaconloc::testing
