@@ -89,6 +89,21 @@ TEST_F(Shards, ShareTheRobotsTakeOverADeadShardsAndGiveANewShardItsShare) {
   std::printf("after a shard joined: the survivor serves %d, the new shard %d of %zu robots\n", share[survivor],
               static_cast<int>(robots.size()) - share[survivor], robots.size());
 
+  // The fleet view names, for every robot, the shard serving it (its participant name ends with
+  // the process id) and its status.
+  const auto [code, fleet] = run_command(command("monitor", {"--fleet", "--duration-s", "3"}), 30s);
+  EXPECT_EQ(code, 0) << fleet;
+  const std::string table = fleet.substr(std::min(fleet.size(), fleet.rfind("fleet: ")));
+  EXPECT_NE(table.find("fleet: 4 robot(s): 4 ok; 0 stale; served by: "), std::string::npos) << fleet;
+  for (const auto& [robot, owner] : owners) {
+    const std::size_t row = table.find("  " + robot + " ");
+    ASSERT_NE(row, std::string::npos) << robot << " not in the fleet view:\n" << fleet;
+    const std::string line = table.substr(row, table.find('\n', row) - row);
+    EXPECT_NE(line.find(" ok "), std::string::npos) << line;
+    EXPECT_NE(line.find(".shard."), std::string::npos) << line;
+    EXPECT_EQ(line.substr(line.rfind('.') + 1), std::to_string(running[owner]->pid())) << line;
+  }
+
   // Handed over or taken over, never served by two shards at once (poses alternating).
   for (const auto& [robot, r] : poses.robots()) {
     EXPECT_FALSE(r.had_conflict) << robot << ": two shards at once; writers in turn:" << writer_turns(poses, robot, killed);

@@ -159,6 +159,9 @@ class MonitorCommand : public Command {
         ->transform(real_in(0.0, kMaxDurationS));
     app_->add_option("--truth", options_.truth_file, "ground truth CSV written by the gateway");
     app_->add_option("--out", options_.out_file, "write every pose to this CSV at the end");
+    app_->add_flag("--fleet", options_.fleet,
+                   "every second, a row per robot: pose status, pose rate, age, its gateway's rejections and the "
+                   "localizer (shard) serving it");
   }
   int execute() override { return run_monitor(options_); }
 

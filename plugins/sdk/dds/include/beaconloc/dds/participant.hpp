@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "beaconloc/core/deadline_watch.hpp"
+#include "beaconloc/core/participant_id.hpp"
 #include "beaconloc/dds/checked_type.hpp"
 #include "beaconloc/dds/periodic_task.hpp"
 #include "beaconloc/dds/topics.hpp"
@@ -86,8 +87,7 @@ inline std::string writer_id(const eprosima::fastdds::dds::InstanceHandle_t& pub
   return s.str();
 }
 
-// The participant a writer belongs to, from writer_id(): its GUID prefix (the first 12 of 16 octets).
-inline std::string participant_of_writer(const std::string& writer) { return writer.substr(0, 24); }
+using beaconloc::participant_of_writer;  // core/participant_id.hpp
 
 // Takes every valid sample a reader has and hands it to a callback with its SampleInfo; keeps
 // the topic's deadline per instance (TopicSpec::deadline_ns: a DeadlineWatch checked on a thread
