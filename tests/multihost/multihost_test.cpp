@@ -10,15 +10,13 @@
 
 #include <chrono>
 #include <cstdio>
-#include <fstream>
-#include <iterator>
 #include <map>
 #include <memory>
-#include <regex>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "discovery_profiles.hpp"
 #include "netns_hosts.hpp"
 #include "participants_test.hpp"
 #include "process.hpp"
@@ -29,42 +27,15 @@ namespace {
 
 using namespace std::chrono_literals;
 
-constexpr const char* kDiscoveryServer = "/usr/bin/fast-discovery-server";
-constexpr int kServerPort = 11811;
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_file(const std::string& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-  if (!out) throw std::runtime_error("cannot write " + path);
-}
-
-// The shipped examples with the namespace hosts' addresses: server 0 on host 1, server 1 on host 2.
-std::string example(const std::string& name) { return read_file(std::string(BEACONLOC_SOURCE_DIR) + "/examples/qos/" + name); }
-std::string client_profile() {
-  std::string xml = example("discovery_client.xml");
-  xml = std::regex_replace(xml, std::regex("192\\.168\\.1\\.10"), NetnsHosts::address(1));
-  return std::regex_replace(xml, std::regex("192\\.168\\.1\\.11"), NetnsHosts::address(2));
-}
-std::string server_profile(int id) {
-  std::string xml = example("discovery_server.xml");
-  xml = std::regex_replace(xml, std::regex("192\\.168\\.1\\.10"), NetnsHosts::address(id + 1));
-  return std::regex_replace(xml, std::regex("44\\.53\\.00\\."), "44.53.0" + std::to_string(id) + ".");
-}
-
 class MultiHost : public ParticipantsTest {
  protected:
   MultiHost() : ParticipantsTest("beaconloc.discovery_client") {}
   void SetUp() override {
     ParticipantsTest::SetUp();
     if (const std::string why = NetnsHosts::unavailable(); !why.empty()) GTEST_SKIP() << why;
-    if (::access(kDiscoveryServer, X_OK) != 0) GTEST_SKIP() << kDiscoveryServer << " not found (Debian's fastdds-tools)";
+    if (::access(kDiscoveryServerProgram, X_OK) != 0) GTEST_SKIP() << kDiscoveryServerProgram << " not found (Debian's fastdds-tools)";
     client_xml_ = path("discovery_client.xml");
-    write_file(client_xml_, client_profile());
+    write_text_file(client_xml_, discovery_client_profile());
     dds_.extra_qos_files = {client_xml_};
     hosts_ = std::make_unique<NetnsHosts>("bl" + std::to_string(::getpid()), 3);
   }
@@ -84,10 +55,10 @@ class MultiHost : public ParticipantsTest {
   // Discovery server `id` (0 or 1) on host id + 1, once it says it runs.
   std::unique_ptr<ChildProcess> start_server(int id) {
     const std::string xml = path("discovery_server_" + std::to_string(id) + ".xml");
-    write_file(xml, server_profile(id));
+    write_text_file(xml, discovery_server_profile(id));
     std::unique_ptr<ChildProcess> server;
     hosts_->run_on(id + 1, [&] {
-      server = std::make_unique<ChildProcess>(std::vector<std::string>{kDiscoveryServer, "-x", xml},
+      server = std::make_unique<ChildProcess>(std::vector<std::string>{kDiscoveryServerProgram, "-x", xml},
                                               path("discovery_server_" + std::to_string(id) + ".log"));
     });
     EXPECT_TRUE(eventually([&] { return server->log().find("Server is running") != std::string::npos; }, 10s))

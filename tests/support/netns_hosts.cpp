@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstring>
 #include <exception>
+#include <regex>
 #include <stdexcept>
 #include <thread>
 
@@ -87,6 +88,21 @@ void NetnsHosts::run_on(int host, const std::function<void()>& fn) {
     }
   }).join();
   if (error) std::rethrow_exception(error);
+}
+
+NetnsHosts::WireTotals NetnsHosts::sent() {
+  const auto [code, json] = run_command({kIp, "-n", prefix_ + "hub", "-s", "-j", "link", "show"}, std::chrono::seconds(10));
+  if (code != 0) throw std::runtime_error("ip -s link in the hub failed: " + json);
+  // Each hub end of a host's veth (vh<i>), its received counters: the first "rx" after its name.
+  static const std::regex kHostEnd("\"ifname\":\"vh[0-9]+\".*?\"rx\":\\{\"bytes\":([0-9]+),\"packets\":([0-9]+)");
+  WireTotals totals;
+  int ends = 0;
+  for (auto it = std::sregex_iterator(json.begin(), json.end(), kHostEnd); it != std::sregex_iterator(); ++it, ++ends) {
+    totals.bytes += std::stoull((*it)[1]);
+    totals.packets += std::stoull((*it)[2]);
+  }
+  if (ends != count_) throw std::runtime_error("ip -s link in the hub: " + std::to_string(ends) + " host ends of " + std::to_string(count_));
+  return totals;
 }
 
 void NetnsHosts::ip(const std::vector<std::string>& args) {

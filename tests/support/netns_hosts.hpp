@@ -3,6 +3,7 @@
 // (issue 19): a hub namespace holding a bridge, and each host a namespace of its own with its
 // loopback and one veth to the hub, at 10.88.0.<host>/24. Nothing leaves the machine: the bridge
 // has no uplink and no host has a route off its subnet. Needs root and iproute2's `ip`.
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -28,6 +29,14 @@ class NetnsHosts {
   // Runs fn on a thread of its own inside the host (the processes it starts are the host's) and
   // waits for it, rethrowing what it threw: the calling thread stays where it is.
   void run_on(int host, const std::function<void()>& fn);
+
+  struct WireTotals {
+    std::uint64_t bytes = 0;  // Ethernet frames, headers included
+    std::uint64_t packets = 0;
+  };
+  // What the hosts have put on the wire so far: the frames the hub received from every host's
+  // veth (a multicast frame counts once, however many hosts the bridge floods it to).
+  WireTotals sent();
 
  private:
   void ip(const std::vector<std::string>& args);  // `ip ARGS`, throws naming it when it fails

@@ -1,7 +1,6 @@
 #pragma once
-// What the shard tests watch (integration.Shards, multihost.*): the live localizer shards as their
-// announcements tell, which shard the assignment gives each robot, and which one its poses come
-// from.
+// What the shard tests check (integration.Shards, multihost.*): which shard the assignment gives
+// each robot, which one its poses come from, and how soon a dead shard's robots are served again.
 #include <beaconlocPubSubTypes.h>
 #include <gtest/gtest.h>
 
@@ -20,39 +19,11 @@
 #include "beaconloc/dds/participant.hpp"
 #include "pose_recorder.hpp"
 #include "process.hpp"
+#include "shard_watcher.hpp"
 
 namespace beaconloc::testing {
 
 using Clock = std::chrono::steady_clock;
-
-// The live shards, as their announcements (LocalizerShard) and its liveliness tell.
-class ShardWatcher {
- public:
-  explicit ShardWatcher(const dds::DdsOptions& dds) : participant_(dds, "beaconloc.test.shards") {
-    dds::ReaderEvents<msg::LocalizerShard> events;
-    events.on_writer_gone = [this](const std::string& writer) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      live_.erase(writer);
-    };
-    reader_ = participant_.subscribe_with_info<msg::LocalizerShardPubSubType>(
-        dds::kLocalizerShardTopic,
-        [this](const msg::LocalizerShard&, const eprosima::fastdds::dds::SampleInfo& info) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          live_.insert(dds::writer_id(info.publication_handle));
-        },
-        events);
-  }
-  std::set<std::string> live() const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return live_;
-  }
-
- private:
-  mutable std::mutex mutex_;
-  std::set<std::string> live_;  // announcement writer ids
-  dds::Participant participant_;
-  dds::Reader reader_;
-};
 
 // robot -> the participant (dds::participant_of_writer) that should serve it among `shards`.
 inline std::map<std::string, std::string> expected_owners(const std::set<std::string>& shards,
