@@ -30,8 +30,8 @@ std::vector<FleetRow> FleetView::update(const std::map<std::string, RobotPoses>&
       row.status = r.newest->row.estimate.status;
       row.age_s = std::chrono::duration<double>(now - r.newest->received).count();
       row.stale = now - r.newest->received > kFleetStaleAfter;
-      const auto p = participants.find(participant_of_writer(r.newest_writer));
-      row.served_by = p != participants.end() ? p->second.name : participant_of_writer(r.newest_writer);
+      const auto p = participants.find(participant_of_writer(r.newest->writer));
+      row.served_by = p != participants.end() ? p->second.name : participant_of_writer(r.newest->writer);
     }
     if (const auto g = gateway_rejected.find(robot); g != gateway_rejected.end()) row.gateway_rejected = g->second;
     rows.push_back(std::move(row));

@@ -68,7 +68,9 @@ std::string participant_name(const std::string& estimator, bool shard) {
 
 // How often a shard asserts its announcement's liveliness: five times a lease (topics.xml), so
 // that a shard stalled for most of a lease by a busy machine keeps its robots.
-constexpr int kShardAssertionsPerLease = 5;
+constexpr StampNs kShardAssertionsPerLease = 5;
+// The longest estimator or participant name an announcement may carry (ours are under 100).
+constexpr std::size_t kMaxShardTextLength = 256;
 }  // namespace
 
 LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core,
@@ -83,7 +85,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       plan_writer_(options_.selective_activation ? participant_.writer<msg::FiringPlanPubSubType>(dds::kFiringPlanTopic)
                                                  : dds::Writer()) {
   own_calibration_writer_ = dds::writer_id(calibration_writer_->get_instance_handle());
-  if (options_.shard) announce_shard();  // before the first sample, which it may not serve
+  if (options_.shard) announce_shard();  // its membership before the first sample, which it may not serve
   if (!options_.calibration_file.empty() && !core_.uses_calibration()) {
     throw CalibrationFileError("calibration file " + options_.calibration_file + ": the estimator " +
                                core_.estimator_name() + " uses no beacon calibration");
@@ -212,29 +214,26 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
 }
 
 bool LocalizerParticipant::serves(const std::string& robot_id) {
-  if (!shard_ || shard_->serves(robot_id, dds::steady_clock_ns())) return true;
+  if (!shard_) return true;
+  const StampNs now_ns = dds::steady_clock_ns();
+  check_shard_stall(now_ns);
+  if (shard_->serves(robot_id, now_ns)) return true;
   ++other_shard_samples_;
   return false;
 }
 
 void LocalizerParticipant::announce_shard() {
   shard_writer_ = participant_.writer<msg::LocalizerShardPubSubType>(dds::kLocalizerShardTopic);
-  const std::string self = dds::writer_id(shard_writer_->get_instance_handle());
-  shard_.emplace(self, core_.estimator_name(), dds::steady_clock_ns(), kShardSettleNs);
-  msg::LocalizerShard m;
-  m.shard(self);
-  m.participant(participant_.name());
-  m.estimator(core_.estimator_name());
-  shard_writer_->write(&m);
-  const eprosima::fastrtps::Duration_t lease = shard_writer_->get_qos().liveliness().lease_duration;
-  const auto lease_ms = std::chrono::milliseconds(static_cast<std::int64_t>(lease.seconds) * 1000 + lease.nanosec / 1'000'000);
-  shard_liveliness_ = std::make_unique<dds::PeriodicTask>(lease_ms / kShardAssertionsPerLease, [this] {
-    // Only a localizer that can take its lock asserts: one stuck under it (a hung estimator) is
-    // taken for gone, and its robots served by the others. Asserted outside the lock: Fast DDS
-    // may tell its own reader at once, whose callback takes the lock.
-    { std::lock_guard<std::mutex> lock(mutex_); }
-    shard_writer_->assert_liveliness();
-  });
+  const eprosima::fastdds::dds::LivelinessQosPolicy liveliness = shard_writer_->get_qos().liveliness();
+  if (liveliness.kind != eprosima::fastdds::dds::MANUAL_BY_TOPIC_LIVELINESS_QOS ||
+      liveliness.lease_duration == eprosima::fastrtps::c_TimeInfinite) {
+    // Without a finite lease asserted by this localizer, a dead or hung shard would keep its
+    // robots for good: the profile was edited, refuse to start.
+    throw dds::DdsError("profile localizer_shard.writer: a shard needs manual-by-topic liveliness with a finite lease");
+  }
+  shard_lease_ns_ = static_cast<StampNs>(liveliness.lease_duration.seconds) * kNsPerSecond +
+                    static_cast<StampNs>(liveliness.lease_duration.nanosec);
+  shard_.emplace(dds::writer_id(shard_writer_->get_instance_handle()), core_.estimator_name(), kShardSettleNs);
 }
 
 void LocalizerParticipant::listen_to_shards() {
@@ -246,14 +245,14 @@ void LocalizerParticipant::listen_to_shards() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       moved = change();
-      if (moved) hand_over_robots();
+      if (moved) release_robots_not_served();
     }
     if (moved) diagnostics_->publish_now();
   };
   dds::ReaderEvents<msg::LocalizerShard> events;
   events.on_writer_gone = [this, changed](const std::string& writer) {
     changed([&] {
-      const bool moved = shard_->on_shard_gone(writer);
+      const bool moved = shard_->on_shard_lost(writer);
       // Its Diagnostics may go on listing its robots for seconds (a killed process's last report):
       // not a conflict with the shard taking them over.
       if (moved) conflicts_.on_peers_gone(dds::participant_of_writer(writer), dds::steady_clock_ns());
@@ -263,22 +262,98 @@ void LocalizerParticipant::listen_to_shards() {
   events.on_writer_alive = [this, changed](const std::string& writer) {
     changed([&] { return shard_->on_shard_alive(writer); });
   };
+  events.on_writer_unmatched = [this, changed](const std::string& writer) {
+    changed([&] { return shard_->on_shard_gone(writer); });  // a restarted shard comes with a new id
+  };
   readers_.push_back(participant_.subscribe_with_info<msg::LocalizerShardPubSubType>(
       dds::kLocalizerShardTopic,
       [this, changed](const msg::LocalizerShard& m, const eprosima::fastdds::dds::SampleInfo& info) {
-        changed([&] { return shard_->on_announcement(dds::writer_id(info.publication_handle), m.estimator()); });
+        const std::string writer = dds::writer_id(info.publication_handle);
+        changed([&] {
+          // Bad announcements are refused and counted; membership keys on the writer alone.
+          if (m.shard() != writer) return refuse_announcement("localizer_shard.id_not_its_writer");
+          if (m.estimator().size() > kMaxShardTextLength || m.participant().size() > kMaxShardTextLength) {
+            return refuse_announcement("localizer_shard.text_too_long");
+          }
+          switch (shard_->on_announcement(writer, m.estimator())) {
+            case ShardMembership::Announcement::kLiveSetChanged:
+              return true;
+            case ShardMembership::Announcement::kEstimatorChanged:
+              return refuse_announcement("localizer_shard.estimator_changed");
+            case ShardMembership::Announcement::kNoChange:
+              break;
+          }
+          return false;
+        });
       },
       events));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    shard_->start_settling(dds::steady_clock_ns());  // now that it hears the others
+  }
+  shard_liveliness_ = std::make_unique<dds::PeriodicTask>(
+      std::chrono::milliseconds(shard_lease_ns_ / kShardAssertionsPerLease / kNsPerMillisecond),
+      [this] { keep_shard_alive(); });
 }
 
-void LocalizerParticipant::hand_over_robots() {
+bool LocalizerParticipant::refuse_announcement(const std::string& reason) {
+  ++shard_announcements_refused_[reason];
+  return false;
+}
+
+void LocalizerParticipant::keep_shard_alive() {
+  bool announce = false, assert_now = false;
+  {
+    // Only a localizer that can take its lock asserts: one stuck under it (a hung estimator) is
+    // taken for gone, and its robots served by the others.
+    std::lock_guard<std::mutex> lock(mutex_);
+    const StampNs now_ns = dds::steady_clock_ns();
+    check_shard_stall(now_ns);
+    // Alive to the others only once settled: they hand its share over as it starts serving it.
+    if (shard_->settled(now_ns)) {
+      assert_now = true;
+      if (!shard_announced_) announce = shard_announced_ = true;
+      shard_asserted_ns_ = now_ns;
+    }
+  }
+  // Outside the lock: Fast DDS may tell this participant's own reader at once, whose callback
+  // takes it.
+  if (announce) {
+    msg::LocalizerShard m;
+    m.shard(shard_->self());
+    m.participant(participant_.name());
+    m.estimator(core_.estimator_name());
+    shard_writer_->write(&m);
+  }
+  if (assert_now) shard_writer_->assert_liveliness();
+}
+
+void LocalizerParticipant::check_shard_stall(StampNs now_ns) {
+  if (!shard_asserted_ns_ || now_ns - *shard_asserted_ns_ <= shard_lease_ns_) return;
+  // Stalled past its lease (stopped, starved, stuck): the others took its robots over and served
+  // them since, while its estimators missed that time. Every robot goes; it settles again,
+  // silent meanwhile, so that the others serve on until it is alive again and then hand its share
+  // back at once, to fresh estimators. Told here by the first sample after the stall as well as
+  // by the liveliness task, whichever runs first.
+  for (const std::string& robot_id : core_.robot_ids()) release_robot(robot_id);
+  conflicts_.set_own_robots({}, now_ns);
+  robots_told_ = 0;
+  ++shard_stalls_;
+  shard_asserted_ns_.reset();
+  shard_->start_settling(now_ns);
+}
+
+void LocalizerParticipant::release_robot(const std::string& robot_id) {
+  core_.release_robot(robot_id);
+  odometry_sequence_.erase(robot_id);
+  plan_sent_ns_.erase(robot_id);
+  ++robots_handed_over_;
+}
+
+void LocalizerParticipant::release_robots_not_served() {
   const StampNs now_ns = dds::steady_clock_ns();
   for (const std::string& robot_id : core_.robot_ids()) {
-    if (shard_->serves(robot_id, now_ns)) continue;
-    core_.release_robot(robot_id);
-    odometry_sequence_.erase(robot_id);
-    plan_sent_ns_.erase(robot_id);
-    ++robots_handed_over_;
+    if (!shard_->serves(robot_id, now_ns)) release_robot(robot_id);
   }
   conflicts_.set_own_robots(core_.robot_ids(), now_ns);
   robots_told_ = core_.robot_count();
@@ -429,9 +504,13 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
     const StampNs now_ns = dds::steady_clock_ns();
     message += "; shard: " + std::to_string(shard_->live_shards()) + " live shard(s) of " + core_.estimator_name() +
                (shard_->settled(now_ns) ? "" : ", settling (serving none yet)") + ", " +
-               std::to_string(robots_handed_over_) + " robot(s) handed over, " +
+               std::to_string(robots_handed_over_) + " robot(s) released, " +
                std::to_string(other_shard_samples_) + " sample(s) of robots it does not serve (other shards', or while settling)";
+    if (shard_stalls_) {
+      message += ", " + std::to_string(shard_stalls_) + " stall(s) past its lease (every robot released)";
+    }
     if (shard_->other_estimator_shards()) {
+      // Another estimator's fleet serves the same robots: the serving conflicts say so.
       message += ", " + std::to_string(shard_->other_estimator_shards()) + " shard(s) of other estimators";
     }
   }
@@ -467,6 +546,7 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   counts.reject("calibration_file.write_failed", calibration_saves_failed_);
   counts.reject("calibration.too_many_beacons", calibrations_refused_too_large_);
   counts.reject("calibration.other_frame", calibrations_refused_other_frame_);
+  for (const auto& [reason, n] : shard_announcements_refused_) counts.reject(reason, n);
   auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, deadline_misses_.load(),
                                  status, message);
   d.writers_lost(odometry_writers_lost_.load() + range_writers_lost_.load());

@@ -66,6 +66,16 @@ class LocalizerParticipant {
     return core_.has_beacon_map();
   }
   StampNs newest_odometry_stamp_ns() const { return newest_odometry_stamp_ns_.load(); }
+  // Shards: the live shards it counts (itself among them; 0 when not a shard), and the robots it
+  // serves now. For benchmarks in the same process.
+  std::size_t live_shards() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return shard_ ? shard_->live_shards() : 0;
+  }
+  std::size_t robots_served() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return core_.robot_count();
+  }
   std::uint64_t lost_increments() {
     std::lock_guard<std::mutex> lock(mutex_);
     return lost_increments_;
@@ -81,11 +91,19 @@ class LocalizerParticipant {
   // Shards: whether this localizer serves the robot now (always, unless a shard); a sample of a
   // robot another shard serves is counted and dropped. Under mutex_.
   bool serves(const std::string& robot_id);
-  // Shards: announces this one and starts keeping its liveliness; then listens to the others.
+  // Shards: its writer and membership, before any sample (announce_shard); then, once every
+  // reader is up, listens to the others, settles, and announces itself (listen_to_shards).
   void announce_shard();
   void listen_to_shards();
-  // After the live shards changed (under mutex_): releases the robots another shard serves now.
-  void hand_over_robots();
+  // On its own thread, lease / 5: once settled, announces (the first time) and asserts the
+  // liveliness; after a stall past the lease releases every robot (check_shard_stall, under mutex_).
+  void keep_shard_alive();
+  void check_shard_stall(StampNs now_ns);
+  bool refuse_announcement(const std::string& reason);  // counted; false (no change). Under mutex_.
+  // A robot another shard serves now, or one this shard held through a stall: its estimator and
+  // bookkeeping go. Under mutex_.
+  void release_robot(const std::string& robot_id);
+  void release_robots_not_served();  // after the live shards changed; under mutex_
   // The site's calibration, when it changed (a robot calibrated a group, another localizer's
   // arrived): on the bus, and into the calibration file. Under mutex_.
   void share_calibration();
@@ -127,7 +145,12 @@ class LocalizerParticipant {
   std::uint64_t plans_sent_ = 0;
   std::optional<ShardMembership> shard_;      // with options_.shard
   std::uint64_t other_shard_samples_ = 0;     // samples of robots it does not serve (serves())
-  std::uint64_t robots_handed_over_ = 0;      // robots released to another shard
+  std::uint64_t robots_handed_over_ = 0;      // robots released (to another shard, or after a stall)
+  std::uint64_t shard_stalls_ = 0;            // stalls past its lease
+  std::map<std::string, std::uint64_t> shard_announcements_refused_;  // by reason
+  StampNs shard_lease_ns_ = 0;                // its announcement writer's (topics.xml)
+  bool shard_announced_ = false;
+  std::optional<StampNs> shard_asserted_ns_;  // the newest assertion; none while settling
   // The entities, owned: the readers, declared last, stop first, before what they use goes.
   dds::Participant participant_;
   dds::Writer pose_writer_;

@@ -7,12 +7,13 @@ std::vector<const PoseWriter*> RobotPoses::current_writers(std::chrono::steady_c
   const bool alternating = last_alternation && now - *last_alternation <= kConcurrentWritersWithin;
   for (const auto& [id, w] : writers) {
     if (now - w.last_heard > kConcurrentWritersWithin) continue;
-    if (alternating || id == newest_writer) out.push_back(&w);
+    if (alternating || (newest && id == newest->writer)) out.push_back(&w);
   }
   return out;
 }
 
-PoseTally::Added PoseTally::add(const RecordedPose& p, const std::string& writer) {
+PoseTally::Added PoseTally::add(const RecordedPose& p) {
+  const std::string& writer = p.writer;
   RobotPoses& r = robots_[p.row.robot_id];
   if (!publishable(p.row.estimate)) {
     ++r.non_finite;
@@ -24,7 +25,7 @@ PoseTally::Added PoseTally::add(const RecordedPose& p, const std::string& writer
   // correction of the other's.)
   const bool correction = !first_of_writer && w.newest_stamp_ns == p.row.estimate.stamp_ns;
   // Back after another writer's pose, its own previous one recent: both serve the robot.
-  if (!first_of_writer && !r.newest_writer.empty() && r.newest_writer != writer &&
+  if (!first_of_writer && r.newest && r.newest->writer != writer &&
       p.received - w.last_heard <= kConcurrentWritersWithin) {
     r.had_conflict = true;
     r.last_alternation = p.received;
@@ -32,7 +33,6 @@ PoseTally::Added PoseTally::add(const RecordedPose& p, const std::string& writer
   w.estimator = p.row.estimator;
   w.newest_stamp_ns = p.row.estimate.stamp_ns;
   w.last_heard = p.received;
-  r.newest_writer = writer;
   // A writer not heard for long, that was never part of a conflict, is forgotten: the state
   // stays O(robots) over restarts of a robot's localizer.
   if (!r.had_conflict) {

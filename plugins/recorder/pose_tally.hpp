@@ -37,7 +37,6 @@ struct RobotPoses {
   std::uint64_t poses = 0;       // finite poses, a writer's correction at its pose's stamp not counted again
   std::uint64_t non_finite = 0;  // refused: not publishable() (a non-finite number, a broken covariance)
   std::map<std::string, PoseWriter> writers;  // by writer id (one per localizer)
-  std::string newest_writer;                  // of the newest pose
   bool had_conflict = false;                  // two writers at once, ever
   std::optional<std::chrono::steady_clock::time_point> last_alternation;  // of the newest conflict
   // The writers serving the robot at `now`: the newest pose's, and while their poses alternated
@@ -52,8 +51,7 @@ class PoseTally {
     kCorrection,  // at the stamp of its writer's newest pose of the robot: it replaces that one
     kNonFinite,   // refused, counted
   };
-  // writer: the id of the writer the pose came from (dds::writer_id).
-  Added add(const RecordedPose& pose, const std::string& writer);
+  Added add(const RecordedPose& pose);
   const std::map<std::string, RobotPoses>& robots() const { return robots_; }
   std::uint64_t poses() const { return poses_; }                         // over every robot
   const std::optional<RecordedPose>& newest() const { return newest_; }  // of any robot

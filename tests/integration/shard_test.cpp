@@ -1,8 +1,9 @@
 // Localizer shards (issue 19): `beaconloc localizer --shard` processes share the robots among the
 // live ones with no coordinator (rendezvous hashing on their announcement writers' ids); a shard
-// killed has its robots served again by the others within 2 s, re-localized from the beacons; a
-// shard started later takes its share without a restart of the others. Never two shards'
-// poses of one robot at once.
+// stalled past its lease or killed has its robots served again by the others within 2 s,
+// re-localized from the beacons, and one back from a stall takes them again; a shard started
+// later takes its share without a restart of the others; the fleet view names the shard serving
+// each robot. Never two shards' poses of one robot at once.
 #include <beaconlocPubSubTypes.h>
 #include <gtest/gtest.h>
 
@@ -60,15 +61,13 @@ TEST_F(Shards, ShareTheRobotsTakeOverADeadShardsAndGiveANewShardItsShare) {
   std::printf("two shards: %d and %d of %zu robots\n", share[running.begin()->first],
               share[std::next(running.begin())->first], robots.size());
 
-  // The shard serving the most robots is killed: no goodbye, only its lapsed liveliness tells.
+  // The shard serving the most robots stalls past its lease (SIGSTOP for 1.5 s): the other one
+  // takes its robots over; back, it takes them again, afresh, never serving one at the same time.
   const std::string victim =
       std::max_element(share.begin(), share.end(), [](const auto& a, const auto& b) { return a.second < b.second; })
           ->first;
-  const Clock::time_point killed = Clock::now();
-  running[victim]->signal(SIGKILL);
-  running[victim]->wait(10s);
-  running.erase(victim);
-  const std::string survivor = running.begin()->first;
+  const std::string survivor = running.begin()->first == victim ? std::next(running.begin())->first
+                                                                 : running.begin()->first;
   std::vector<std::string> taken_over;
   for (const auto& [robot, owner] : owners) {
     if (owner == victim) taken_over.push_back(robot);
@@ -76,11 +75,26 @@ TEST_F(Shards, ShareTheRobotsTakeOverADeadShardsAndGiveANewShardItsShare) {
   ASSERT_FALSE(taken_over.empty());
   std::map<std::string, std::string> now_owners;
   for (const std::string& robot : robots) now_owners[robot] = survivor;
+  const Clock::time_point stopped = Clock::now();
+  ASSERT_TRUE(running[victim]->stop(5s));
+  expect_taken_over_within_2s(poses, taken_over, now_owners, stopped, "stopped");
+  running[victim]->signal(SIGCONT);
+  EXPECT_TRUE(eventually([&] { return served_as_assigned(poses, owners); }, 30s)) << running[victim]->log();
+  for (const auto& [robot, r] : poses.robots()) {
+    EXPECT_FALSE(r.had_conflict) << robot << ": two shards at once; writers in turn:" << writer_turns(poses, robot, stopped);
+  }
+
+  // Then it is killed: no goodbye, only its lapsed liveliness tells.
+  const Clock::time_point killed = Clock::now();
+  running[victim]->signal(SIGKILL);
+  running[victim]->wait(10s);
+  running.erase(victim);
   expect_taken_over_within_2s(poses, taken_over, now_owners, killed);
   ASSERT_TRUE(eventually([&] { return shards.live().size() == 1; }, 10s));
 
   // A new shard takes its share; the survivor hands those robots over without a restart.
-  start_shard(shards, shard_process("shard-c"), running);
+  const std::string shard_c = start_shard_with_a_share(shards, shard_process("shard-c"), running, robots);
+  ASSERT_FALSE(shard_c.empty());
   ASSERT_EQ(shards.live().size(), 2u);
   owners = expected_owners(shards.live(), robots);
   EXPECT_TRUE(eventually([&] { return served_as_assigned(poses, owners); }, 30s)) << running[survivor]->log();

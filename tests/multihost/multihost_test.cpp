@@ -102,7 +102,7 @@ TEST_F(MultiHost, ShardsOnTwoHostsServeAThirdsRobotsThroughTwoDiscoveryServers) 
   server0->signal(SIGKILL);
   server0->wait(10s);
   const Clock::time_point joined = Clock::now();
-  const std::string shard_c = start_shard(shards, shard_on(1, "shard-c"), running);
+  const std::string shard_c = start_shard_with_a_share(shards, shard_on(1, "shard-c"), running, robots);
   ASSERT_FALSE(shard_c.empty()) << "a shard started with one server down was never found";
   ASSERT_EQ(shards.live().size(), 3u);
   owners = expected_owners(shards.live(), robots);

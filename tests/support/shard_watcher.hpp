@@ -11,7 +11,8 @@
 
 namespace beaconloc::testing {
 
-// The live shards, as their announcements (LocalizerShard) and its liveliness tell.
+// The live shards, as their announcements (LocalizerShard) and their liveliness tell: a shard
+// lost is live again once its liveliness is.
 class ShardWatcher {
  public:
   explicit ShardWatcher(const dds::DdsOptions& dds) : participant_(dds, "beaconloc.test.shards") {
@@ -20,10 +21,19 @@ class ShardWatcher {
       std::lock_guard<std::mutex> lock(mutex_);
       live_.erase(writer);
     };
+    events.on_writer_alive = [this](const std::string& writer) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (announced_.count(writer)) live_.insert(writer);
+    };
+    events.on_writer_unmatched = [this](const std::string& writer) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      announced_.erase(writer);
+    };
     reader_ = participant_.subscribe_with_info<msg::LocalizerShardPubSubType>(
         dds::kLocalizerShardTopic,
         [this](const msg::LocalizerShard&, const eprosima::fastdds::dds::SampleInfo& info) {
           std::lock_guard<std::mutex> lock(mutex_);
+          announced_.insert(dds::writer_id(info.publication_handle));
           live_.insert(dds::writer_id(info.publication_handle));
         },
         events);
@@ -35,7 +45,8 @@ class ShardWatcher {
 
  private:
   mutable std::mutex mutex_;
-  std::set<std::string> live_;  // announcement writer ids
+  std::set<std::string> live_;       // announcement writer ids
+  std::set<std::string> announced_;  // of the shards not gone for good
   dds::Participant participant_;
   dds::Reader reader_;
 };

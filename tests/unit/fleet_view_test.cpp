@@ -28,7 +28,7 @@ void add_poses(PoseTally& tally, const std::string& robot, const std::string& pa
     p.row.estimate.status = status;
     p.received = from + i * 10ms;
     p.writer = participant + "00000102";
-    tally.add(p, p.writer);
+    tally.add(p);
   }
 }
 
