@@ -41,9 +41,9 @@ enum class Mode { kSimple, kServers };
 const char* name(Mode m) { return m == Mode::kSimple ? "simple" : "servers"; }
 
 struct Setup {
-  std::string dir;          // logs and profiles
-  std::string simple_xml;   // network.xml as shipped
-  std::string client_xml;   // discovery_client.xml with the hosts' addresses
+  std::string dir;         // logs and profiles
+  std::string simple_xml;  // network.xml as shipped
+  std::string client_xml;  // discovery_client.xml with the hosts' addresses
   int domain_id = 0;
   double window_s = 10.0;
   double steady_s = 5.0;
@@ -98,8 +98,9 @@ Outcome run(Mode mode, int shards, const Setup& s, int round) {
   for (int i = 0; i < shards; ++i) {
     hosts.run_on(1 + i % 3, [&] {
       running.push_back(std::make_unique<ChildProcess>(
-          std::vector<std::string>{BEACONLOC_EXECUTABLE, "localizer", "--shard", "--domain", std::to_string(s.domain_id),
-                                   "--participant-profile", profile, "--qos", xml},
+          std::vector<std::string>{BEACONLOC_EXECUTABLE, "localizer", "--shard", "--domain",
+                                   std::to_string(s.domain_id), "--participant-profile", profile, "--qos",
+                                   xml},
           s.dir + "/" + tag + "-shard" + std::to_string(i) + ".log"));
     });
   }
@@ -107,7 +108,8 @@ Outcome run(Mode mode, int shards, const Setup& s, int round) {
                              std::chrono::seconds(30));
   out.found_s = std::chrono::duration<double>(Clock::now() - started).count();
   if (!out.all_found) {
-    out.failure = std::to_string(watcher.live().size()) + " of " + std::to_string(shards) + " shards found in 30 s";
+    out.failure =
+        std::to_string(watcher.live().size()) + " of " + std::to_string(shards) + " shards found in 30 s";
   }
   std::this_thread::sleep_until(started + std::chrono::duration<double>(s.window_s));
   const NetnsHosts::WireTotals window_end = hosts.sent();
@@ -132,8 +134,10 @@ int main(int argc, char** argv) {
   std::string csv;
   Setup s;
   app.add_option("--shards", shard_counts, "shard counts, e.g. \"4 8 16\"");
-  app.add_option("--window-s", s.window_s, "seconds from the first start measured as discovery")->check(CLI::PositiveNumber);
-  app.add_option("--steady-s", s.steady_s, "seconds after the window measured as steady")->check(CLI::PositiveNumber);
+  app.add_option("--window-s", s.window_s, "seconds from the first start measured as discovery")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--steady-s", s.steady_s, "seconds after the window measured as steady")
+      ->check(CLI::PositiveNumber);
   app.add_option("--csv", csv, "append rows benchmark,case,metric,value,unit");
   CLI11_PARSE(app, argc, argv);
   if (const std::string why = testing::NetnsHosts::unavailable(); !why.empty()) {
@@ -141,7 +145,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (::access(testing::kDiscoveryServerProgram, X_OK) != 0) {
-    std::fprintf(stderr, "discovery benchmark: %s not found (Debian's fastdds-tools)\n", testing::kDiscoveryServerProgram);
+    std::fprintf(stderr, "discovery benchmark: %s not found (Debian's fastdds-tools)\n",
+                 testing::kDiscoveryServerProgram);
     return 2;
   }
   char dir[] = "/tmp/beaconloc-discovery-XXXXXX";
@@ -160,7 +165,8 @@ int main(int argc, char** argv) {
       const Outcome o = run(mode, shards, s, round++);
       if (!o.all_found) {
         // A run that found nothing is a failure with its reason, never a figure.
-        std::fprintf(stderr, "discovery %s, %d shards: %s (logs in %s)\n", name(mode), shards, o.failure.c_str(), dir);
+        std::fprintf(stderr, "discovery %s, %d shards: %s (logs in %s)\n", name(mode), shards,
+                     o.failure.c_str(), dir);
         ++failures;
         continue;
       }

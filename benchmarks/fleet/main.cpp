@@ -119,16 +119,20 @@ int measure(const Run& run, Served& localizer, double rss_empty_mb, double rss_p
   }
   std::this_thread::sleep_for(std::chrono::seconds(1));  // discovery before the first sample
   if constexpr (std::is_same_v<Served, LocalizerParticipant>) {
-    // Every shard known and settled before the first sample: none is handed over in the window.
-    const auto end = Clock::now() + std::chrono::duration<double>(shards_wait_s) - std::chrono::nanoseconds(kShardSettleNs);
-    while (localizer.live_shards() < static_cast<std::size_t>(run.shards) && Clock::now() < end) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (run.shards > 1) {
+      // Every shard known and settled before the first sample: none is handed over in the window.
+      const auto end =
+          Clock::now() + std::chrono::duration<double>(shards_wait_s) - std::chrono::nanoseconds(kShardSettleNs);
+      while (localizer.live_shards() < static_cast<std::size_t>(run.shards) && Clock::now() < end) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+      if (localizer.live_shards() < static_cast<std::size_t>(run.shards)) {
+        std::fprintf(stderr, "fleet benchmark: %zu of %d shards found in time\n", localizer.live_shards(),
+                     run.shards);
+        return 1;
+      }
+      std::this_thread::sleep_for(std::chrono::nanoseconds(kShardSettleNs));
     }
-    if (localizer.live_shards() < static_cast<std::size_t>(run.shards)) {
-      std::fprintf(stderr, "fleet benchmark: %zu of %d shards found in time\n", localizer.live_shards(), run.shards);
-      return 1;
-    }
-    std::this_thread::sleep_for(std::chrono::nanoseconds(kShardSettleNs));
   }
   testing::ChildProcess feeder(args({self, "--role", "feeder", "--robots", std::to_string(robots),
                                      "--seconds", std::to_string(total_s + 1.5)}),

@@ -33,7 +33,8 @@ std::vector<FleetRow> FleetView::update(const std::map<std::string, RobotPoses>&
       const auto p = participants.find(participant_of_writer(r.newest->writer));
       row.served_by = p != participants.end() ? p->second.name : participant_of_writer(r.newest->writer);
     }
-    if (const auto g = gateway_rejected.find(robot); g != gateway_rejected.end()) row.gateway_rejected = g->second;
+    if (const auto g = gateway_rejected.find(robot); g != gateway_rejected.end())
+      row.gateway_rejected = g->second;
     rows.push_back(std::move(row));
   }
   previous_ = now;
@@ -63,11 +64,12 @@ std::string format_fleet(const std::vector<FleetRow>& rows) {
   }
   out += "\n";
   char line[512];
-  std::snprintf(line, sizeof line, "  %-16s %-13s %7s %7s %9s  %s\n", "robot", "status", "pose/s", "age s", "rejected",
-                "served by");
+  std::snprintf(line, sizeof line, "  %-16s %-13s %7s %7s %9s  %s\n", "robot", "status", "pose/s", "age s",
+                "rejected", "served by");
   out += line;
   for (const FleetRow& r : rows) {
-    const std::string status = r.status ? std::string(to_string(*r.status)) + (r.stale ? " stale" : "") : "no pose";
+    const std::string status =
+        r.status ? std::string(to_string(*r.status)) + (r.stale ? " stale" : "") : "no pose";
     const std::string rejected = r.gateway_rejected ? std::to_string(*r.gateway_rejected) : "-";
     std::snprintf(line, sizeof line, "  %-16s %-13s %7.1f %7.2f %9s  %s\n", r.robot.c_str(), status.c_str(),
                   r.pose_rate_hz, r.age_s, rejected.c_str(), r.served_by.empty() ? "-" : r.served_by.c_str());

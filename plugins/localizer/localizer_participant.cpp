@@ -505,7 +505,8 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
     message += "; shard: " + std::to_string(shard_->live_shards()) + " live shard(s) of " + core_.estimator_name() +
                (shard_->settled(now_ns) ? "" : ", settling (serving none yet)") + ", " +
                std::to_string(robots_handed_over_) + " robot(s) released, " +
-               std::to_string(other_shard_samples_) + " sample(s) of robots it does not serve (other shards', or while settling)";
+               std::to_string(other_shard_samples_) +
+               " sample(s) of robots it does not serve (other shards', or while settling)";
     if (shard_stalls_) {
       message += ", " + std::to_string(shard_stalls_) + " stall(s) past its lease (every robot released)";
     }

@@ -37,7 +37,9 @@ class ShardMembership {
   // its lease (the others took its robots; they hand them back when it is alive again). Serves
   // nothing until settled.
   void start_settling(StampNs now_ns) { settling_from_ns_ = now_ns; }
-  bool settled(StampNs now_ns) const { return settling_from_ns_ && now_ns - *settling_from_ns_ >= settle_ns_; }
+  bool settled(StampNs now_ns) const {
+    return settling_from_ns_ && now_ns - *settling_from_ns_ >= settle_ns_;
+  }
 
   enum class Announcement {
     kNoChange,          // its own, or a shard heard again

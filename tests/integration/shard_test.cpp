@@ -6,6 +6,7 @@
 // each robot. Never two shards' poses of one robot at once.
 #include <beaconlocPubSubTypes.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -39,14 +40,16 @@ TEST_F(Shards, ShareTheRobotsTakeOverADeadShardsAndGiveANewShardItsShare) {
   ShardWatcher shards(dds_);
   std::vector<std::unique_ptr<ChildProcess>> gateways;
   for (const std::string& robot : robots) {
-    gateways.push_back(std::make_unique<ChildProcess>(command("gateway", {"--robot", robot, "--duration-s", "0"}),
-                                                      path("gateway-" + robot + ".log")));
+    gateways.push_back(std::make_unique<ChildProcess>(
+        command("gateway", {"--robot", robot, "--duration-s", "0"}), path("gateway-" + robot + ".log")));
   }
   ChildProcess decoder(command("decoder"), path("decoder.log"));
   // Shards by their participant id (the announcement's writer's prefix).
   std::map<std::string, std::unique_ptr<ChildProcess>> running;
   auto shard_process = [&](const std::string& name) {
-    return [this, name] { return std::make_unique<ChildProcess>(command("localizer", {"--shard"}), path(name + ".log")); };
+    return [this, name] {
+      return std::make_unique<ChildProcess>(command("localizer", {"--shard"}), path(name + ".log"));
+    };
   };
   start_shard(shards, shard_process("shard-a"), running);
   start_shard(shards, shard_process("shard-b"), running);
@@ -63,11 +66,11 @@ TEST_F(Shards, ShareTheRobotsTakeOverADeadShardsAndGiveANewShardItsShare) {
 
   // The shard serving the most robots stalls past its lease (SIGSTOP for 1.5 s): the other one
   // takes its robots over; back, it takes them again, afresh, never serving one at the same time.
-  const std::string victim =
-      std::max_element(share.begin(), share.end(), [](const auto& a, const auto& b) { return a.second < b.second; })
-          ->first;
-  const std::string survivor = running.begin()->first == victim ? std::next(running.begin())->first
-                                                                 : running.begin()->first;
+  const std::string victim = std::max_element(share.begin(), share.end(), [](const auto& a, const auto& b) {
+                               return a.second < b.second;
+                             })->first;
+  const std::string survivor =
+      running.begin()->first == victim ? std::next(running.begin())->first : running.begin()->first;
   std::vector<std::string> taken_over;
   for (const auto& [robot, owner] : owners) {
     if (owner == victim) taken_over.push_back(robot);
@@ -81,7 +84,8 @@ TEST_F(Shards, ShareTheRobotsTakeOverADeadShardsAndGiveANewShardItsShare) {
   running[victim]->signal(SIGCONT);
   EXPECT_TRUE(eventually([&] { return served_as_assigned(poses, owners); }, 30s)) << running[victim]->log();
   for (const auto& [robot, r] : poses.robots()) {
-    EXPECT_FALSE(r.had_conflict) << robot << ": two shards at once; writers in turn:" << writer_turns(poses, robot, stopped);
+    EXPECT_FALSE(r.had_conflict) << robot << ": two shards at once; writers in turn:"
+                                 << writer_turns(poses, robot, stopped);
   }
 
   // Then it is killed: no goodbye, only its lapsed liveliness tells.
@@ -100,8 +104,8 @@ TEST_F(Shards, ShareTheRobotsTakeOverADeadShardsAndGiveANewShardItsShare) {
   EXPECT_TRUE(eventually([&] { return served_as_assigned(poses, owners); }, 30s)) << running[survivor]->log();
   share.clear();
   for (const auto& [robot, owner] : owners) ++share[owner];
-  std::printf("after a shard joined: the survivor serves %d, the new shard %d of %zu robots\n", share[survivor],
-              static_cast<int>(robots.size()) - share[survivor], robots.size());
+  std::printf("after a shard joined: the survivor serves %d, the new shard %d of %zu robots\n",
+              share[survivor], static_cast<int>(robots.size()) - share[survivor], robots.size());
 
   // The fleet view names, for every robot, the shard serving it (its participant name ends with
   // the process id) and its status.
@@ -120,11 +124,64 @@ TEST_F(Shards, ShareTheRobotsTakeOverADeadShardsAndGiveANewShardItsShare) {
 
   // Handed over or taken over, never served by two shards at once (poses alternating).
   for (const auto& [robot, r] : poses.robots()) {
-    EXPECT_FALSE(r.had_conflict) << robot << ": two shards at once; writers in turn:" << writer_turns(poses, robot, killed);
+    EXPECT_FALSE(r.had_conflict) << robot << ": two shards at once; writers in turn:"
+                                 << writer_turns(poses, robot, killed);
   }
   for (auto& [id, shard] : running) stop_cleanly(*shard, "shard");
   stop_cleanly(decoder, "decoder");
   for (auto& gateway : gateways) stop_cleanly(*gateway, "gateway");
+}
+
+// Bad announcements on localizer_shard are refused and counted by reason, and move no robot: a
+// shard id that is not its writer's, names longer than any real one, an estimator changed.
+TEST_F(Shards, BadAnnouncementsAreRefusedAndCounted) {
+  DiagnosticsRecorder diagnostics(dds_);
+  ChildProcess shard(command("localizer", {"--shard"}), path("shard.log"));
+  char host[256] = {};
+  ASSERT_EQ(::gethostname(host, sizeof host - 1), 0);
+  const std::string name = kRangeEkfLocalizer + ".shard." + host + "." + std::to_string(shard.pid());
+  auto says = [&](auto pred) { return wait_for_diagnostics(diagnostics, name, pred); };
+  const auto live = says(
+      [](const msg::Diagnostics& d) { return d.message().find("1 live shard(s)") != std::string::npos; });
+  ASSERT_NE(live.message().find("1 live shard(s)"), std::string::npos) << shard.log();
+
+  // A shard's writer holds one instance, its own: a writer for the forged id, another for the rest.
+  dds::Participant bus(dds_, "beaconloc.test.forger");
+  dds::Writer forger = bus.writer<msg::LocalizerShardPubSubType>(dds::kLocalizerShardTopic);
+  dds::Writer writer = bus.writer<msg::LocalizerShardPubSubType>(dds::kLocalizerShardTopic);
+  ASSERT_TRUE(dds::wait_for_matched_readers({forger, writer}, scaled(10s)));
+  const std::string own_id = dds::writer_id(writer->get_instance_handle());
+  // One at a time, each seen counted before the next: the writer keeps the newest.
+  auto write_until = [&](const dds::Writer& w, msg::LocalizerShard m, auto seen) {
+    EXPECT_TRUE(w->write(&m));
+    return says(seen);
+  };
+  msg::LocalizerShard m;
+  m.participant("forger");
+  m.estimator("range_ekf");
+  m.shard(own_id);  // the other writer's id
+  write_until(forger, m, [](const msg::Diagnostics& d) {
+    return rejected_count(d, "localizer_shard.id_not_its_writer") > 0;
+  });
+  m.shard(own_id);
+  m.estimator(std::string(300, 'x'));
+  write_until(writer, m, [](const msg::Diagnostics& d) {
+    return rejected_count(d, "localizer_shard.text_too_long") > 0;
+  });
+  m.estimator("duhl");  // another estimator's shard: no peer, accepted
+  write_until(writer, m, [](const msg::Diagnostics& d) {
+    return d.message().find("1 shard(s) of other estimators") != std::string::npos;
+  });
+  m.estimator("range_ekf");  // and now, the same writer, this one's: refused
+  const msg::Diagnostics d = write_until(writer, m, [](const msg::Diagnostics& r) {
+    return rejected_count(r, "localizer_shard.estimator_changed") > 0;
+  });
+  EXPECT_EQ(rejected_count(d, "localizer_shard.id_not_its_writer"), 1u) << d.message();
+  EXPECT_EQ(rejected_count(d, "localizer_shard.text_too_long"), 1u) << d.message();
+  EXPECT_EQ(rejected_count(d, "localizer_shard.estimator_changed"), 1u) << d.message();
+  EXPECT_NE(d.message().find("1 live shard(s) of range_ekf"), std::string::npos) << d.message();
+  EXPECT_NE(d.message().find("1 shard(s) of other estimators"), std::string::npos) << d.message();
+  stop_cleanly(shard, "shard");
 }
 
 }  // namespace

@@ -33,7 +33,8 @@ class MultiHost : public ParticipantsTest {
   void SetUp() override {
     ParticipantsTest::SetUp();
     if (const std::string why = NetnsHosts::unavailable(); !why.empty()) GTEST_SKIP() << why;
-    if (::access(kDiscoveryServerProgram, X_OK) != 0) GTEST_SKIP() << kDiscoveryServerProgram << " not found (Debian's fastdds-tools)";
+    if (::access(kDiscoveryServerProgram, X_OK) != 0)
+      GTEST_SKIP() << kDiscoveryServerProgram << " not found (Debian's fastdds-tools)";
     client_xml_ = path("discovery_client.xml");
     write_text_file(client_xml_, discovery_client_profile());
     dds_.extra_qos_files = {client_xml_};
@@ -44,8 +45,8 @@ class MultiHost : public ParticipantsTest {
     ParticipantsTest::TearDown();
   }
   // `beaconloc <sub>` as a client of the two servers, on a host.
-  std::unique_ptr<ChildProcess> start_on(int host, const std::string& sub, const std::vector<std::string>& extra,
-                                         const std::string& log) {
+  std::unique_ptr<ChildProcess> start_on(int host, const std::string& sub,
+                                         const std::vector<std::string>& extra, const std::string& log) {
     std::vector<std::string> args{"--qos", client_xml_};
     args.insert(args.end(), extra.begin(), extra.end());
     std::unique_ptr<ChildProcess> child;
@@ -82,7 +83,8 @@ TEST_F(MultiHost, ShardsOnTwoHostsServeAThirdsRobotsThroughTwoDiscoveryServers) 
   const Clock::time_point started = Clock::now();
   std::vector<std::unique_ptr<ChildProcess>> on_host1;
   for (const std::string& robot : robots) {
-    on_host1.push_back(start_on(1, "gateway", {"--robot", robot, "--duration-s", "0"}, "gateway-" + robot + ".log"));
+    on_host1.push_back(
+        start_on(1, "gateway", {"--robot", robot, "--duration-s", "0"}, "gateway-" + robot + ".log"));
   }
   on_host1.push_back(start_on(1, "decoder", {}, "decoder.log"));
   std::map<std::string, std::unique_ptr<ChildProcess>> running;
@@ -93,9 +95,11 @@ TEST_F(MultiHost, ShardsOnTwoHostsServeAThirdsRobotsThroughTwoDiscoveryServers) 
   start_shard(shards, shard_on(3, "shard-b"), running);
   ASSERT_EQ(shards.live().size(), 2u);
   auto owners = expected_owners(shards.live(), robots);
-  ASSERT_TRUE(eventually([&] { return served_as_assigned(poses, owners); }, 30s)) << running.begin()->second->log();
-  std::printf("across hosts: %zu robots on host 1 localized by shards on hosts 2 and 3, %.2f s after the start\n",
-              robots.size(), std::chrono::duration<double>(Clock::now() - started).count());
+  ASSERT_TRUE(eventually([&] { return served_as_assigned(poses, owners); }, 30s))
+      << running.begin()->second->log();
+  std::printf(
+      "across hosts: %zu robots on host 1 localized by shards on hosts 2 and 3, %.2f s after the start\n",
+      robots.size(), std::chrono::duration<double>(Clock::now() - started).count());
 
   // Server 0 killed: a shard started afterwards (on host 1, beside the dead server) is found, and
   // finds the others, through server 1 alone.
@@ -109,9 +113,10 @@ TEST_F(MultiHost, ShardsOnTwoHostsServeAThirdsRobotsThroughTwoDiscoveryServers) 
   EXPECT_TRUE(eventually([&] { return served_as_assigned(poses, owners); }, 30s)) << running[shard_c]->log();
   std::map<std::string, int> share;
   for (const auto& [robot, owner] : owners) ++share[owner];
-  std::printf("server 0 killed: a shard started after it was found and serves its share (%d of %zu robots) "
-              "%.2f s after its start\n",
-              share[shard_c], robots.size(), std::chrono::duration<double>(Clock::now() - joined).count());
+  std::printf(
+      "server 0 killed: a shard started after it was found and serves its share (%d of %zu robots) "
+      "%.2f s after its start\n",
+      share[shard_c], robots.size(), std::chrono::duration<double>(Clock::now() - joined).count());
 
   // The shard serving the most robots killed: the two others take its robots over.
   std::string victim = share.begin()->first;
@@ -133,7 +138,8 @@ TEST_F(MultiHost, ShardsOnTwoHostsServeAThirdsRobotsThroughTwoDiscoveryServers) 
   expect_taken_over_within_2s(poses, taken_over, expected_owners(left, robots), killed);
 
   for (const auto& [robot, r] : poses.robots()) {
-    EXPECT_FALSE(r.had_conflict) << robot << ": two shards at once; writers in turn:" << writer_turns(poses, robot, killed);
+    EXPECT_FALSE(r.had_conflict) << robot << ": two shards at once; writers in turn:"
+                                 << writer_turns(poses, robot, killed);
   }
   for (auto& [id, shard] : running) stop_cleanly(*shard, "shard");
   for (auto& p : on_host1) stop_cleanly(*p, "host 1 participant");

@@ -21,12 +21,14 @@ const std::regex kServer1Address("192\\.168\\.1\\.11");
 }  // namespace
 
 std::string discovery_client_profile() {
-  const std::string xml = std::regex_replace(example("discovery_client.xml"), kServer0Address, NetnsHosts::address(1));
+  const std::string xml =
+      std::regex_replace(example("discovery_client.xml"), kServer0Address, NetnsHosts::address(1));
   return std::regex_replace(xml, kServer1Address, NetnsHosts::address(2));
 }
 
 std::string discovery_server_profile(int id) {
-  const std::string xml = std::regex_replace(example("discovery_server.xml"), kServer0Address, NetnsHosts::address(id + 1));
+  const std::string xml =
+      std::regex_replace(example("discovery_server.xml"), kServer0Address, NetnsHosts::address(id + 1));
   // The prefix fast-discovery-server gives server id `id`: its third octet.
   return std::regex_replace(xml, std::regex("44\\.53\\.00\\."), "44.53.0" + std::to_string(id) + ".");
 }

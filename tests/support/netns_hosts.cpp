@@ -36,7 +36,8 @@ std::string NetnsHosts::unavailable() {
 
 NetnsHosts::NetnsHosts(const std::string& prefix, int count) : prefix_(prefix), count_(count) {
   home_fd_ = ::open("/proc/thread-self/ns/net", O_RDONLY | O_CLOEXEC);
-  if (home_fd_ < 0) throw std::runtime_error(std::string("cannot open this thread's namespace: ") + std::strerror(errno));
+  if (home_fd_ < 0)
+    throw std::runtime_error(std::string("cannot open this thread's namespace: ") + std::strerror(errno));
   try {
     const std::string hub = prefix_ + "hub";
     ip({"netns", "add", hub});
@@ -75,7 +76,9 @@ void NetnsHosts::remove() {
   made_.clear();
 }
 
-void NetnsHosts::enter(int host) { enter_namespace("/var/run/netns/" + prefix_ + "h" + std::to_string(host)); }
+void NetnsHosts::enter(int host) {
+  enter_namespace("/var/run/netns/" + prefix_ + "h" + std::to_string(host));
+}
 
 void NetnsHosts::run_on(int host, const std::function<void()>& fn) {
   std::exception_ptr error;
@@ -91,17 +94,22 @@ void NetnsHosts::run_on(int host, const std::function<void()>& fn) {
 }
 
 NetnsHosts::WireTotals NetnsHosts::sent() {
-  const auto [code, json] = run_command({kIp, "-n", prefix_ + "hub", "-s", "-j", "link", "show"}, std::chrono::seconds(10));
+  const auto [code, json] =
+      run_command({kIp, "-n", prefix_ + "hub", "-s", "-j", "link", "show"}, std::chrono::seconds(10));
   if (code != 0) throw std::runtime_error("ip -s link in the hub failed: " + json);
   // Each hub end of a host's veth (vh<i>), its received counters: the first "rx" after its name.
-  static const std::regex kHostEnd("\"ifname\":\"vh[0-9]+\".*?\"rx\":\\{\"bytes\":([0-9]+),\"packets\":([0-9]+)");
+  static const std::regex kHostEnd(
+      "\"ifname\":\"vh[0-9]+\".*?\"rx\":\\{\"bytes\":([0-9]+),\"packets\":([0-9]+)");
   WireTotals totals;
   int ends = 0;
-  for (auto it = std::sregex_iterator(json.begin(), json.end(), kHostEnd); it != std::sregex_iterator(); ++it, ++ends) {
+  for (auto it = std::sregex_iterator(json.begin(), json.end(), kHostEnd); it != std::sregex_iterator();
+       ++it, ++ends) {
     totals.bytes += std::stoull((*it)[1]);
     totals.packets += std::stoull((*it)[2]);
   }
-  if (ends != count_) throw std::runtime_error("ip -s link in the hub: " + std::to_string(ends) + " host ends of " + std::to_string(count_));
+  if (ends != count_)
+    throw std::runtime_error("ip -s link in the hub: " + std::to_string(ends) + " host ends of " +
+                             std::to_string(count_));
   return totals;
 }
 

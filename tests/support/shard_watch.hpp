@@ -27,7 +27,7 @@ using Clock = std::chrono::steady_clock;
 
 // robot -> the participant (dds::participant_of_writer) that should serve it among `shards`.
 inline std::map<std::string, std::string> expected_owners(const std::set<std::string>& shards,
-                                                   const std::vector<std::string>& robots) {
+                                                          const std::vector<std::string>& robots) {
   ShardAssignment assignment(*shards.begin());
   assignment.set_live({shards.begin(), shards.end()});
   std::map<std::string, std::string> out;
@@ -40,13 +40,15 @@ inline bool served_as_assigned(const PoseRecorder& poses, const std::map<std::st
   const auto robots = poses.robots();
   return std::all_of(owners.begin(), owners.end(), [&](const auto& robot_owner) {
     const auto it = robots.find(robot_owner.first);
-    return it != robots.end() && it->second.newest && it->second.newest->row.estimate.status == PoseStatus::kOk &&
+    return it != robots.end() && it->second.newest &&
+           it->second.newest->row.estimate.status == PoseStatus::kOk &&
            dds::participant_of_writer(it->second.newest->writer) == robot_owner.second;
   });
 }
 
 // The writers of a robot's poses in turn: "participant from +t s" (since `since`), for a failure.
-inline std::string writer_turns(const PoseRecorder& poses, const std::string& robot, Clock::time_point since) {
+inline std::string writer_turns(const PoseRecorder& poses, const std::string& robot,
+                                Clock::time_point since) {
   std::string out, writer;
   for (const RecordedPose& p : poses.poses()) {
     if (p.row.robot_id != robot || p.writer == writer) continue;
@@ -64,7 +66,8 @@ inline std::optional<double> first_pose_from(const PoseRecorder& poses, const st
                                              bool ok_only) {
   std::optional<double> first;
   for (const RecordedPose& p : poses.poses()) {
-    if (p.row.robot_id != robot || p.received < since || dds::participant_of_writer(p.writer) != participant) continue;
+    if (p.row.robot_id != robot || p.received < since || dds::participant_of_writer(p.writer) != participant)
+      continue;
     if (ok_only && p.row.estimate.status != PoseStatus::kOk) continue;
     const double s = std::chrono::duration<double>(p.received - since).count();
     if (!first || s < *first) first = s;
@@ -74,7 +77,8 @@ inline std::optional<double> first_pose_from(const PoseRecorder& poses, const st
 
 // Starts a shard (start) and waits for its announcement; `running` keeps it by its participant id,
 // which is returned ("" with a test failure when it never announces itself).
-inline std::string start_shard(const ShardWatcher& shards, const std::function<std::unique_ptr<ChildProcess>()>& start,
+inline std::string start_shard(const ShardWatcher& shards,
+                               const std::function<std::unique_ptr<ChildProcess>()>& start,
                                std::map<std::string, std::unique_ptr<ChildProcess>>& running) {
   using namespace std::chrono_literals;
   const std::set<std::string> before = shards.live();
@@ -114,7 +118,8 @@ inline std::string start_shard_with_a_share(const ShardWatcher& shards,
     EXPECT_TRUE(eventually(
         [&] {
           const auto live = shards.live();
-          return std::none_of(live.begin(), live.end(), [&](const std::string& s) { return dds::participant_of_writer(s) == id; });
+          return std::none_of(live.begin(), live.end(),
+                              [&](const std::string& s) { return dds::participant_of_writer(s) == id; });
         },
         10s));
   }
@@ -126,18 +131,19 @@ inline std::string start_shard_with_a_share(const ShardWatcher& shards,
 // `owners` now gives it: prints how long after its first pose and its first ok pose came, and
 // expects the first within issue 19's 2 s (scaled() under the sanitizers).
 inline void expect_taken_over_within_2s(const PoseRecorder& poses, const std::vector<std::string>& robots,
-                                        const std::map<std::string, std::string>& owners, Clock::time_point killed,
-                                        const char* what = "killed") {
+                                        const std::map<std::string, std::string>& owners,
+                                        Clock::time_point killed, const char* what = "killed") {
   using namespace std::chrono_literals;
   for (const std::string& robot : robots) {
     const std::string& owner = owners.at(robot);
-    EXPECT_TRUE(eventually([&] { return first_pose_from(poses, robot, owner, killed, true).has_value(); }, 10s))
+    EXPECT_TRUE(
+        eventually([&] { return first_pose_from(poses, robot, owner, killed, true).has_value(); }, 10s))
         << robot << " not served again after its shard was killed";
     const auto first = first_pose_from(poses, robot, owner, killed, false);
     const auto first_ok = first_pose_from(poses, robot, owner, killed, true);
     if (!first || !first_ok) continue;
-    std::printf("takeover: %s served again %.2f s after its shard was %s, ok %.2f s after\n", robot.c_str(), *first,
-                what, *first_ok);
+    std::printf("takeover: %s served again %.2f s after its shard was %s, ok %.2f s after\n", robot.c_str(),
+                *first, what, *first_ok);
     EXPECT_LE(*first, std::chrono::duration<double>(scaled(2000ms)).count()) << robot;
   }
 }

@@ -18,8 +18,8 @@ using Clock = std::chrono::steady_clock;
 const std::string kShardA = "0102030405060708090a0b0c";  // participant ids: 24 hex digits
 const std::string kShardB = "0102030405060708090a0bff";
 
-void add_poses(PoseTally& tally, const std::string& robot, const std::string& participant, int n, Clock::time_point from,
-               PoseStatus status) {
+void add_poses(PoseTally& tally, const std::string& robot, const std::string& participant, int n,
+               Clock::time_point from, PoseStatus status) {
   for (int i = 0; i < n; ++i) {
     RecordedPose p;
     p.row.robot_id = robot;
@@ -59,7 +59,7 @@ TEST(FleetView, ARowPerRobotWithItsRateAgeRejectionsAndServingShard) {
   EXPECT_FALSE(rows[0].stale);
   EXPECT_EQ(rows[1].robot, "r2");
   EXPECT_EQ(rows[1].pose_rate_hz, 0.0);
-  EXPECT_TRUE(rows[1].stale);  // 2.01 s without a pose
+  EXPECT_TRUE(rows[1].stale);                          // 2.01 s without a pose
   EXPECT_FALSE(rows[1].gateway_rejected.has_value());  // no gateway of that name reports
   const std::string text = format_fleet(rows);
   EXPECT_NE(text.find("fleet: 2 robot(s): 1 initializing, 1 ok; 1 stale; served by: "
