@@ -217,13 +217,14 @@ bool LocalizerParticipant::serves(const std::string& robot_id) {
   if (!shard_) return true;
   const StampNs now_ns = dds::steady_clock_ns();
   check_shard_stall(now_ns);
-  if (shard_->serves(robot_id, now_ns)) return true;
+  // Serves once alive to the others (its first assertion after settling), not a tick before.
+  if (shard_asserted_ns_ && shard_->serves(robot_id, now_ns)) return true;
   ++other_shard_samples_;
   return false;
 }
 
 void LocalizerParticipant::announce_shard() {
-  shard_writer_ = participant_.writer<msg::LocalizerShardPubSubType>(dds::kLocalizerShardTopic);
+  shard_writer_ = participant_.writer<msg::LocalizerShardPubSubType>(dds::kLocalizerShardTopic, &shard_matches_);
   const eprosima::fastdds::dds::LivelinessQosPolicy liveliness = shard_writer_->get_qos().liveliness();
   if (liveliness.kind != eprosima::fastdds::dds::MANUAL_BY_TOPIC_LIVELINESS_QOS ||
       liveliness.lease_duration == eprosima::fastrtps::c_TimeInfinite) {
@@ -244,8 +245,10 @@ void LocalizerParticipant::listen_to_shards() {
     bool moved = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      const bool stalled = check_shard_stall(dds::steady_clock_ns());  // robots from before a stall go first
       moved = change();
       if (moved) release_robots_not_served();
+      moved = moved || stalled;
     }
     if (moved) diagnostics_->publish_now();
   };
@@ -291,8 +294,16 @@ void LocalizerParticipant::listen_to_shards() {
     std::lock_guard<std::mutex> lock(mutex_);
     shard_->start_settling(dds::steady_clock_ns());  // now that it hears the others
   }
+  const eprosima::fastdds::dds::LivelinessQosPolicy heard = readers_.back()->get_qos().liveliness();
+  if (heard.kind != eprosima::fastdds::dds::MANUAL_BY_TOPIC_LIVELINESS_QOS ||
+      !(shard_writer_->get_qos().liveliness().lease_duration <= heard.lease_duration)) {
+    // Incompatible with its own writer: the shards would never match, each serving every robot.
+    throw dds::DdsError(
+        "profile localizer_shard.reader: manual-by-topic liveliness with a lease at least the writer's");
+  }
   shard_liveliness_ = std::make_unique<dds::PeriodicTask>(
-      std::chrono::milliseconds(shard_lease_ns_ / kShardAssertionsPerLease / kNsPerMillisecond),
+      std::max(std::chrono::milliseconds(1),
+               std::chrono::milliseconds(shard_lease_ns_ / kShardAssertionsPerLease / kNsPerMillisecond)),
       [this] { keep_shard_alive(); });
 }
 
@@ -312,7 +323,11 @@ void LocalizerParticipant::keep_shard_alive() {
     // Alive to the others only once settled: they hand its share over as it starts serving it.
     if (shard_->settled(now_ns)) {
       assert_now = true;
-      if (!shard_announced_) announce = shard_announced_ = true;
+      // Announced once settled, and again whenever a reader matched since: a shard that lost and
+      // found it again (a partition, a stall past the participant's lease) may not be sent a
+      // sample it was sent before.
+      const bool new_reader = shard_matches_.matched_since_asked();
+      if (!shard_announced_ || new_reader) announce = shard_announced_ = true;
       shard_asserted_ns_ = now_ns;
     }
   }
@@ -328,8 +343,11 @@ void LocalizerParticipant::keep_shard_alive() {
   if (assert_now) shard_writer_->assert_liveliness();
 }
 
-void LocalizerParticipant::check_shard_stall(StampNs now_ns) {
-  if (!shard_asserted_ns_ || now_ns - *shard_asserted_ns_ <= shard_lease_ns_) return;
+bool LocalizerParticipant::check_shard_stall(StampNs now_ns) {
+  // Past the lease less one assertion period: the others' lease runs from when an assertion
+  // reached them, a little after it was sent.
+  const StampNs stalled_after_ns = shard_lease_ns_ - shard_lease_ns_ / kShardAssertionsPerLease;
+  if (!shard_ || !shard_asserted_ns_ || now_ns - *shard_asserted_ns_ <= stalled_after_ns) return false;
   // Stalled past its lease (stopped, starved, stuck): the others took its robots over and served
   // them since, while its estimators missed that time. Every robot goes; it settles again,
   // silent meanwhile, so that the others serve on until it is alive again and then hand its share
@@ -341,6 +359,7 @@ void LocalizerParticipant::check_shard_stall(StampNs now_ns) {
   ++shard_stalls_;
   shard_asserted_ns_.reset();
   shard_->start_settling(now_ns);
+  return true;
 }
 
 void LocalizerParticipant::release_robot(const std::string& robot_id) {
@@ -419,6 +438,8 @@ void LocalizerParticipant::publish_firing_plan(const std::string& robot_id, Stam
 }
 
 void LocalizerParticipant::publish(const LocalizerOutput& out) {
+  // A sample taken before a stall and fused after it: its robot was just released, no pose.
+  if (check_shard_stall(dds::steady_clock_ns())) return;
   if (core_.robot_count() != robots_told_) {  // a new robot: is it contested? (once per robot)
     conflicts_.set_own_robots(core_.robot_ids(), dds::steady_clock_ns());
     robots_told_ = core_.robot_count();
@@ -465,6 +486,7 @@ void LocalizerParticipant::share_calibration() {
 
 msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   std::lock_guard<std::mutex> lock(mutex_);
+  check_shard_stall(dds::steady_clock_ns());  // never the robots held through a stall
   std::vector<std::string> robots = core_.robot_ids();
   conflicts_.set_own_robots(robots, dds::steady_clock_ns());  // and drops the peers gone silent
   const PoseStatus worst = core_.worst_status();

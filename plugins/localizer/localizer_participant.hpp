@@ -98,7 +98,7 @@ class LocalizerParticipant {
   // On its own thread, lease / 5: once settled, announces (the first time) and asserts the
   // liveliness; after a stall past the lease releases every robot (check_shard_stall, under mutex_).
   void keep_shard_alive();
-  void check_shard_stall(StampNs now_ns);
+  bool check_shard_stall(StampNs now_ns);  // whether it found a stall (robots released); under mutex_
   bool refuse_announcement(const std::string& reason);  // counted; false (no change). Under mutex_.
   // A robot another shard serves now, or one this shard held through a stall: its estimator and
   // bookkeeping go. Under mutex_.
@@ -151,7 +151,21 @@ class LocalizerParticipant {
   StampNs shard_lease_ns_ = 0;                // its announcement writer's (topics.xml)
   bool shard_announced_ = false;
   std::optional<StampNs> shard_asserted_ns_;  // the newest assertion; none while settling
-  // The entities, owned: the readers, declared last, stop first, before what they use goes.
+  // Readers matched by the announcement writer since last asked: it announces again.
+  class MatchListener : public eprosima::fastdds::dds::DataWriterListener {
+   public:
+    void on_publication_matched(eprosima::fastdds::dds::DataWriter*,
+                                const eprosima::fastdds::dds::PublicationMatchedStatus& s) override {
+      if (s.current_count_change > 0) matched_ = true;
+    }
+    bool matched_since_asked() { return matched_.exchange(false); }
+
+   private:
+    std::atomic<bool> matched_{false};
+  };
+  MatchListener shard_matches_;  // outlives shard_writer_
+  // The entities, owned, declared last and so gone first (the shard's liveliness task, then the
+  // readers, then the writers), before what they use goes.
   dds::Participant participant_;
   dds::Writer pose_writer_;
   dds::Writer state_writer_;  // EstimatorState: what the estimator holds beside the pose

@@ -64,7 +64,8 @@ TEST_F(Shards, ShareTheRobotsTakeOverADeadShardsAndGiveANewShardItsShare) {
   std::printf("two shards: %d and %d of %zu robots\n", share[running.begin()->first],
               share[std::next(running.begin())->first], robots.size());
 
-  // The shard serving the most robots stalls past its lease (SIGSTOP for 1.5 s): the other one
+  // The shard serving the most robots stalls past its lease (SIGSTOP until its robots are taken
+  // over, about 1 s): the other one
   // takes its robots over; back, it takes them again, afresh, never serving one at the same time.
   const std::string victim = std::max_element(share.begin(), share.end(), [](const auto& a, const auto& b) {
                                return a.second < b.second;
