@@ -75,6 +75,33 @@ inline std::optional<double> first_pose_from(const PoseRecorder& poses, const st
   return first;
 }
 
+// Odometry stamps at which two shards published a pose of the robot: each shard publishes one
+// pose per odometry stamp it serves, so these are the steps the robot was served twice. A
+// handover shares a few (the old shard serves until it hears the new one); a late-delivered
+// pose of the old shard, a shard taking its robots back after a stall, share none.
+inline std::size_t stamps_served_twice(const PoseRecorder& poses, const std::string& robot) {
+  std::map<StampNs, std::set<std::string>> writers_at;
+  for (const RecordedPose& p : poses.poses()) {
+    if (p.row.robot_id == robot) writers_at[p.row.estimate.stamp_ns].insert(p.writer);
+  }
+  return static_cast<std::size_t>(std::count_if(writers_at.begin(), writers_at.end(),
+                                                [](const auto& at) { return at.second.size() > 1; }));
+}
+
+// Expects no robot served twice for more than 20 odometry steps (0.2 s; scaled() under the
+// sanitizers), printing the most; `since` dates the writer turns printed on failure.
+inline void expect_no_double_serving(const PoseRecorder& poses, Clock::time_point since) {
+  std::size_t most = 0;
+  for (const auto& [robot, r] : poses.robots()) {
+    const std::size_t twice = stamps_served_twice(poses, robot);
+    most = std::max(most, twice);
+    EXPECT_LE(twice, static_cast<std::size_t>(20 * kTimeScale))
+        << robot << ": " << twice
+        << " odometry steps served by two shards; writers in turn:" << writer_turns(poses, robot, since);
+  }
+  std::printf("most odometry steps of one robot served by two shards: %zu\n", most);
+}
+
 // Starts a shard (start) and waits for its announcement; `running` keeps it by its participant id,
 // which is returned ("" with a test failure when it never announces itself).
 inline std::string start_shard(const ShardWatcher& shards,
