@@ -7,6 +7,7 @@
 #
 #   --quick    every benchmark briefly, to check that it runs (CI); not figures to quote.
 #   --repeat   repetitions of each multi-process case (default 3); medians are over them.
+#   --shards   shard counts of the discovery comparison (default "4 8 16")
 #   --robots   robot counts of the fleet sweep (default "100 200 250 300 350 400 500"); each count
 #              runs the localizer and, in turn, the bare Fast DDS relay (--bare) as its yardstick.
 #   --out      output directory (default build/bench): results.csv (every run), medians.csv.
@@ -19,12 +20,14 @@ cd "$(dirname "$0")/.."
 quick=0
 repeat=3
 robots="100 200 250 300 350 400 500"
+shards="4 8 16"
 out=build/bench
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) quick=1 ;;
     --repeat) repeat="$2"; shift ;;
     --robots) robots="$2"; shift ;;
+    --shards) shards="$2"; shift ;;
     --out) out="$2"; shift ;;
     *) echo "bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -33,12 +36,13 @@ done
 if [ "$quick" = 1 ]; then
   repeat=1
   robots="5"
+  shards="3"
 fi
 
 dir=build/release
 cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DBEACONLOC_WERROR=ON -DBEACONLOC_BUILD_BENCHMARKS=ON >/dev/null
 cmake --build "$dir" -j 2 --target beaconloc beaconloc_benchmarks beaconloc_latency beaconloc_fleet_benchmark \
-  beaconloc_footprint_benchmark
+  beaconloc_footprint_benchmark beaconloc_discovery_benchmark
 mkdir -p "$out"
 csv="$out/results.csv"
 rm -f "$csv" "$out/medians.csv"
@@ -100,6 +104,21 @@ if [ "$quick" = 1 ]; then
   "$bin/footprint/beaconloc_footprint_benchmark" --runs 1 --settle-s 3 --csv "$csv"
 else
   "$bin/footprint/beaconloc_footprint_benchmark" --runs 5 --csv "$csv"
+fi
+
+# 5. Discovery across hosts (network namespaces, root only): simple discovery against two
+#    discovery servers, side by side in each run.
+echo "== discovery across hosts"
+if [ "$(id -u)" -ne 0 ]; then
+  echo "bench.sh: discovery across hosts skipped: network namespaces need root"
+else
+  for ((i = 1; i <= repeat; i++)); do
+    if [ "$quick" = 1 ]; then
+      "$bin/discovery/beaconloc_discovery_benchmark" --shards "$shards" --window-s 4 --steady-s 2 --csv "$csv"
+    else
+      "$bin/discovery/beaconloc_discovery_benchmark" --shards "$shards" --window-s 10 --steady-s 5 --csv "$csv"
+    fi
+  done
 fi
 
 # Medians over the repetitions of each benchmark,case,metric (rows in the order first seen).

@@ -11,6 +11,9 @@ $SUDO apt-get install -y --no-install-recommends \
   libeigen3-dev libcli11-dev libyaml-cpp-dev \
   libgtest-dev libgmock-dev libbenchmark-dev \
   cyclonedds-dev cyclonedds-tools \
+  fastdds-tools iproute2 \
   clang libclang-rt-14-dev llvm
+# fastdds-tools (fast-discovery-server) and iproute2 (ip netns): the multi-host tests, whose hosts
+# are network namespaces finding each other through two discovery servers (tests/multihost).
 # clang, libclang-rt-14-dev (libFuzzer, ASan and UBSan runtimes) and llvm (llvm-symbolizer, for
 # readable reports): the fuzz targets, scripts/fuzz.sh.

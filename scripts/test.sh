@@ -2,7 +2,7 @@
 # The test suite, three builds (warnings are errors in the first two):
 # 1. build/asan: Debug at -O1 (Eigen's assertions on) with AddressSanitizer, LeakSanitizer and
 #    UndefinedBehaviorSanitizer (scripts/build.sh Asan). Runs every unit test and every
-#    multi-process integration test (the Cyclone DDS peer included) with the runtime settings of
+#    multi-process integration and multi-host test (the Cyclone DDS peer included) with the runtime settings of
 #    scripts/sanitizers.env; any sanitizer report fails the run. Not Run.ReplaysTheSharedRecordings
 #    (only where ../shared/datasets is; the full recordings take many minutes under ASan): the
 #    30 s fixture of Run.ReplaysTheTucFixture takes the same code path. Not integration.Qos.*:
@@ -23,7 +23,7 @@ bash scripts/build.sh Asan
   set -a
   . scripts/sanitizers.env
   set +a
-  ctest --test-dir build/asan -R '^(unit|integration)\.' \
+  ctest --test-dir build/asan -R '^(unit|integration|multihost)\.' \
     -E '^integration\.(Run\.ReplaysTheSharedRecordings|Qos\..*)$' \
     -j 2 --output-on-failure
 )

@@ -23,11 +23,13 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "beaconloc/dds/convert.hpp"
@@ -74,6 +76,7 @@ struct Run {
   double warmup_s = 0.0, window_s = 0.0;
   bool with_sink = true;
   bool bare = false;
+  int shards = 1;  // >1: this localizer is one of that many shards (--shard), the others children
   std::string csv;
 };
 
@@ -88,7 +91,9 @@ int measure(const Run& run, Served& localizer, double rss_empty_mb, double rss_p
   const bool with_sink = run.with_sink;
 
   const double total_s = warmup_s + window_s;
-  const StampNs window_from_ns = dds::wall_clock_ns() + s_to_ns(warmup_s + 1.0);
+  // With shards, up to 3 s more before the feeder starts: the shards find each other and settle.
+  const double shards_wait_s = run.shards > 1 ? 3.0 : 0.0;
+  const StampNs window_from_ns = dds::wall_clock_ns() + s_to_ns(warmup_s + 1.0 + shards_wait_s);
   const StampNs window_to_ns = window_from_ns + s_to_ns(window_s);
   const std::string dir = "/tmp/beaconloc-fleet-" + std::to_string(getpid());
   std::filesystem::create_directories(dir);
@@ -105,7 +110,30 @@ int measure(const Run& run, Served& localizer, double rss_empty_mb, double rss_p
                  dir + "/sink.log");
   }
   testing::ChildProcess decoder(args({BEACONLOC_EXECUTABLE, "decoder"}), dir + "/decoder.log");
+  // The other shards: `beaconloc localizer --shard` with the estimator and receivers of this one.
+  std::vector<std::unique_ptr<testing::ChildProcess>> other_shards;
+  for (int i = 1; i < run.shards; ++i) {
+    other_shards.push_back(std::make_unique<testing::ChildProcess>(
+        args({BEACONLOC_EXECUTABLE, "localizer", "--shard", "--estimator", "range_ekf"}),
+        dir + "/shard" + std::to_string(i) + ".log"));
+  }
   std::this_thread::sleep_for(std::chrono::seconds(1));  // discovery before the first sample
+  if constexpr (std::is_same_v<Served, LocalizerParticipant>) {
+    if (run.shards > 1) {
+      // Every shard known and settled before the first sample: none is handed over in the window.
+      const auto end =
+          Clock::now() + std::chrono::duration<double>(shards_wait_s) - std::chrono::nanoseconds(kShardSettleNs);
+      while (localizer.live_shards() < static_cast<std::size_t>(run.shards) && Clock::now() < end) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+      if (localizer.live_shards() < static_cast<std::size_t>(run.shards)) {
+        std::fprintf(stderr, "fleet benchmark: %zu of %d shards found in time\n", localizer.live_shards(),
+                     run.shards);
+        return 1;
+      }
+      std::this_thread::sleep_for(std::chrono::nanoseconds(kShardSettleNs));
+    }
+  }
   testing::ChildProcess feeder(args({self, "--role", "feeder", "--robots", std::to_string(robots),
                                      "--seconds", std::to_string(total_s + 1.5)}),
                                dir + "/feeder.log");
@@ -115,6 +143,8 @@ int measure(const Run& run, Served& localizer, double rss_empty_mb, double rss_p
                                 std::chrono::nanoseconds(window_from_ns - dds::wall_clock_ns()));
   const LocalizerSample begin = sample(localizer);
   const double lost_begin = static_cast<double>(localizer.lost_increments());
+  double other_shards_cpu_begin = 0.0;
+  for (const auto& p : other_shards) other_shards_cpu_begin += process_cpu_s(p->pid());
   const double feeder_cpu_begin = process_cpu_s(feeder.pid()),
                decoder_cpu_begin = process_cpu_s(decoder.pid()),
                sink_cpu_begin = sink ? process_cpu_s(sink->pid()) : 0.0;
@@ -127,14 +157,20 @@ int measure(const Run& run, Served& localizer, double rss_empty_mb, double rss_p
   const double feeder_cpu = process_cpu_s(feeder.pid()) - feeder_cpu_begin;
   const double decoder_cpu = process_cpu_s(decoder.pid()) - decoder_cpu_begin;
   const double sink_cpu = sink ? process_cpu_s(sink->pid()) - sink_cpu_begin : 0.0;
+  double other_shards_cpu = -other_shards_cpu_begin;
+  for (const auto& p : other_shards) other_shards_cpu += process_cpu_s(p->pid());
+  std::size_t robots_served = static_cast<std::size_t>(robots);
+  if constexpr (std::is_same_v<Served, LocalizerParticipant>) robots_served = localizer.robots_served();
   const double lost = static_cast<double>(localizer.lost_increments()) - lost_begin;
   const double rss_mb = resident_mb(getpid());
   const auto feeder_exit = feeder.wait(std::chrono::seconds(30));
   std::this_thread::sleep_for(std::chrono::milliseconds(500));  // the last poses reach the sink
   if (sink) sink->signal(SIGINT);
   decoder.signal(SIGINT);
+  for (auto& p : other_shards) p->signal(SIGINT);
   const auto sink_exit = sink ? sink->wait(std::chrono::seconds(10)) : std::optional<int>(0);
   decoder.wait(std::chrono::seconds(10));
+  for (auto& p : other_shards) p->wait(std::chrono::seconds(10));
   const std::string sink_log = sink ? sink->log() : std::string();
   auto field = [&](const std::string& key) { return log_field(sink_log, key); };
   const double expected_poses = robots * 100.0 * window_s;
@@ -147,11 +183,19 @@ int measure(const Run& run, Served& localizer, double rss_empty_mb, double rss_p
       feeder_exit == 0 && sink_exit == 0 && delivered && lost == 0.0 && lag_growth_ms < 50.0;
 
   const double cpu_pct = 100.0 * (end.cpu_s - begin.cpu_s) / window_s;
-  Results r(std::string(run.bare ? "fleet_bare_dds" : "fleet") + (with_sink ? "" : "_no_sink"),
+  Results r(std::string(run.bare ? "fleet_bare_dds" : "fleet") + (with_sink ? "" : "_no_sink") +
+                (run.shards > 1 ? "_shards=" + std::to_string(run.shards) : ""),
             "robots=" + std::to_string(robots));
   r.add("robots", robots, "count");
   r.add("localizer_cpu", cpu_pct, "%core");
   r.add("localizer_cpu_per_robot", cpu_pct / robots, "%core");
+  if (run.shards > 1) {
+    // This shard receives every robot's samples and serves its share.
+    r.add("robots_served", static_cast<double>(robots_served), "count");
+    r.add("localizer_cpu_per_robot_served", robots_served ? cpu_pct / static_cast<double>(robots_served) : 0.0,
+          "%core");
+    r.add("other_shards_cpu", 100.0 * other_shards_cpu / window_s, "%core");
+  }
   r.add("localizer_rss", rss_mb, "MB");
   r.add("localizer_rss_per_robot", (rss_mb - rss_participant_mb) * 1024.0 / robots, "kB");
   r.add("localizer_rss_without_robots", rss_participant_mb, "MB");
@@ -189,7 +233,9 @@ int run_localizer(const Run& run) {
   const sim::Scenario scenario = sim::default_scenario();
   EstimatorConfig config;
   config.receivers = scenario.receivers;
-  LocalizerParticipant localizer(run.dds, LocalizerCore("range_ekf", config));
+  LocalizerParticipantOptions options;
+  options.shard = run.shards > 1;
+  LocalizerParticipant localizer(run.dds, LocalizerCore("range_ekf", config), options);
   return measure(run, localizer, rss_empty_mb, resident_mb(getpid()));
 }
 
@@ -203,6 +249,7 @@ int main(int argc, char** argv) {
   double warmup_s = 5.0, window_s = 15.0, seconds = 10.0;
   long long from_ns = 0, to_ns = 0;
   bool no_sink = false, bare = false;
+  int shards = 1;
   beaconloc::dds::DdsOptions dds;
   dds.domain_id = 0;
   app.add_option("--role", role, "localizer (default; runs the others), feeder or sink")
@@ -224,7 +271,15 @@ int main(int argc, char** argv) {
   app.add_flag("--bare", bare,
                "a bare Fast DDS relay in the localizer's place (bare_relay.hpp): the same samples in and "
                "out, no estimator; the middleware's own cost of these rates");
+  app.add_option("--shards", shards,
+                 "this localizer as one of K shards (--shard), the K-1 others `beaconloc localizer --shard` "
+                 "children: its CPU per robot it serves, receiving every robot's samples")
+      ->check(CLI::Range(1, 16));
   CLI11_PARSE(app, argc, argv);
+  if (bare && shards > 1) {
+    std::fprintf(stderr, "fleet benchmark: --bare has no shards\n");
+    return 2;
+  }
   std::optional<beaconloc::testing::DomainLease> lease;
   if (dds.domain_id == 0) dds.domain_id = lease.emplace().id();
   try {
@@ -233,7 +288,7 @@ int main(int argc, char** argv) {
     if (role == "feeder") return beaconloc::bench::run_feeder(dds, robots, seconds);
     if (role == "sink") return beaconloc::bench::run_sink(dds, from_ns, to_ns);
     return beaconloc::bench::run_localizer(
-        {dds, beaconloc::bench::self_executable(), robots, warmup_s, window_s, !no_sink, bare, csv});
+        {dds, beaconloc::bench::self_executable(), robots, warmup_s, window_s, !no_sink, bare, shards, csv});
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fleet benchmark: %s\n", e.what());
     return 2;

@@ -8,6 +8,7 @@
 
 #include "beaconloc/dds/stop_signal.hpp"
 #include "diagnostics_recorder.hpp"
+#include "fleet_view.hpp"
 #include "pipeline.hpp"
 #include "pose_recorder.hpp"
 
@@ -49,6 +50,17 @@ void print_robot(const std::string& robot, const RobotPoses& r, std::uint64_t sh
   std::printf("\n");
 }
 
+// The participants by id, for the fleet view: each one's name and rejections over every reason.
+std::map<std::string, FleetParticipant> fleet_participants(const std::map<std::string, ParticipantReport>& reports) {
+  std::map<std::string, FleetParticipant> out;
+  for (const auto& [name, report] : reports) {
+    FleetParticipant p{name, 0};
+    for (const msg::RejectionCount& r : report.last.rejected()) p.rejected += r.count();
+    out[report.participant_id] = std::move(p);
+  }
+  return out;
+}
+
 }  // namespace
 
 int run_monitor(const MonitorOptions& o) {
@@ -59,6 +71,7 @@ int run_monitor(const MonitorOptions& o) {
   const auto start = Clock::now();
   std::map<std::string, std::uint64_t> shown;                         // poses counted per robot
   std::map<std::string, std::pair<Liveness, int>> participant_shown;  // liveness, status
+  FleetView fleet;
   while (!dds::wait_for_stop(std::chrono::seconds(1))) {
     const auto now = Clock::now();
     const auto robots = recorder.robots();
@@ -66,12 +79,17 @@ int run_monitor(const MonitorOptions& o) {
       std::printf("monitor: no pose received (%.0f s)\n",
                   std::floor(std::chrono::duration<double>(now - start).count()));
     }
-    for (const auto& [robot, r] : robots) {
-      print_robot(robot, r, shown[robot], now);
-      shown[robot] = r.poses;
+    const auto reports = diagnostics.reports();
+    if (o.fleet) {
+      if (!robots.empty()) std::cout << format_fleet(fleet.update(robots, fleet_participants(reports), now));
+    } else {
+      for (const auto& [robot, r] : robots) {
+        print_robot(robot, r, shown[robot], now);
+        shown[robot] = r.poses;
+      }
     }
     // A participant's line when it appears, and whenever its liveness or status changes.
-    for (const auto& [name, report] : diagnostics.reports()) {
+    for (const auto& [name, report] : reports) {
       const std::pair<Liveness, int> state{report.liveness, static_cast<int>(report.last.status())};
       auto [it, first] = participant_shown.try_emplace(name, state);
       if (first || it->second != state) {

@@ -13,6 +13,9 @@ struct MonitorOptions {
   double duration_s = 0.0;  // 0: until stopped
   std::string truth_file;   // score the poses against it at the end
   std::string out_file;     // write every pose to this CSV at the end
+  // Every second, the fleet view (fleet_view.hpp: a row per robot with its status, pose rate,
+  // age, rejections and the localizer serving it) instead of a pose line per robot.
+  bool fleet = false;
 };
 
 // The exit code: 1 when a truth file was given and no pose came to score.

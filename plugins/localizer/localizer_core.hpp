@@ -127,6 +127,9 @@ class LocalizerCore {
     return it == robots_.end() ? nullptr : &it->second.fusion.estimator();
   }
   std::vector<std::string> robot_ids() const;  // the robots it has an estimator for, sorted
+  // Drops the robot's estimator and what it held (another localizer shard serves it now); its
+  // next sample, if it comes back, starts it afresh. Returns whether it was served.
+  bool release_robot(const std::string& robot_id) { return robots_.erase(robot_id) != 0; }
   // The worst status over the robots served (kOk when none).
   PoseStatus worst_status() const;
   // The robot's start-up condition while it has no pose (nullopt once it has one, or unknown).

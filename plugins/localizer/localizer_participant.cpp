@@ -2,6 +2,8 @@
 
 #include <beaconlocPubSubTypes.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 
@@ -30,8 +32,10 @@ void LocalizerParticipant::subscribe_beacon_measurements(const dds::TopicSpec& t
           // Written under the lock, as every pose is, so that a robot's poses go out in stamp
           // order: a correction at once, not with the next odometry sample.
           std::lock_guard<std::mutex> lock(mutex_);
-          if (auto corrected = fuse(m)) publish(*corrected);
-          share_calibration();
+          if (serves(m.robot_id())) {
+            if (auto corrected = fuse(m)) publish(*corrected);
+            share_calibration();
+          }
         }
         ++ranges_processed_;
       },
@@ -51,6 +55,22 @@ std::optional<BeaconCalibration> kept_calibration(const std::string& path) {
   }
   return kept;
 }
+
+// A shard's participant name tells the shards apart in the Diagnostics (the monitor, a peer's
+// serving conflicts): the host and the process.
+std::string participant_name(const std::string& estimator, bool shard) {
+  std::string name = "beaconloc.localizer." + estimator;
+  if (!shard) return name;
+  char host[256] = {};
+  if (gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+  return name + ".shard." + (host[0] ? host : "unknown-host") + "." + std::to_string(getpid());
+}
+
+// How often a shard asserts its announcement's liveliness: five times a lease (topics.xml), so
+// that a shard stalled for most of a lease by a busy machine keeps its robots.
+constexpr StampNs kShardAssertionsPerLease = 5;
+// The longest estimator or participant name an announcement may carry (ours are under 100).
+constexpr std::size_t kMaxShardTextLength = 256;
 }  // namespace
 
 LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, LocalizerCore core,
@@ -58,13 +78,14 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
     : core_(std::move(core)),
       conflicts_(std::chrono::duration_cast<std::chrono::nanoseconds>(dds::kDiagnosticsSilentAfter).count()),
       options_(std::move(options)),
-      participant_(dds, "beaconloc.localizer." + core_.estimator_name()),
+      participant_(dds, participant_name(core_.estimator_name(), options_.shard)),
       pose_writer_(participant_.writer<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic)),
       state_writer_(participant_.writer<msg::EstimatorStatePubSubType>(dds::kEstimatorStateTopic)),
       calibration_writer_(participant_.writer<msg::BeaconCalibrationPubSubType>(dds::kBeaconCalibrationTopic)),
       plan_writer_(options_.selective_activation ? participant_.writer<msg::FiringPlanPubSubType>(dds::kFiringPlanTopic)
                                                  : dds::Writer()) {
   own_calibration_writer_ = dds::writer_id(calibration_writer_->get_instance_handle());
+  if (options_.shard) announce_shard();  // its membership before the first sample, which it may not serve
   if (!options_.calibration_file.empty() && !core_.uses_calibration()) {
     throw CalibrationFileError("calibration file " + options_.calibration_file + ": the estimator " +
                                core_.estimator_name() + " uses no beacon calibration");
@@ -157,6 +178,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
   if (core_.uses_laser()) {
     readers_.push_back(participant_.subscribe<msg::LaserScanPubSubType>(dds::kLaserScanTopic, [this](const msg::LaserScan& m) {
       std::lock_guard<std::mutex> lock(mutex_);
+      if (!serves(m.robot_id())) return;
       if (auto corrected = core_.on_laser(m.robot_id(), dds::from_msg(m))) publish(*corrected);
       share_calibration();
     }));
@@ -166,6 +188,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
         Cov3 c;
         for (int i = 0; i < 9; ++i) c(i / 3, i % 3) = m.covariance()[static_cast<std::size_t>(i)];
         std::lock_guard<std::mutex> lock(mutex_);
+        if (!serves(m.robot_id())) return;
         core_.on_initial_pose(m.robot_id(), m.stamp_ns(), Pose2(m.x_m(), m.y_m(), m.yaw_rad()), c);
       }));
   diagnostics_ =
@@ -187,6 +210,172 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
         on_peer_diagnostics(d, dds::writer_id(info.publication_handle));
       },
       peer_events));
+  if (options_.shard) listen_to_shards();  // after diagnostics_, which a change of shards publishes
+}
+
+bool LocalizerParticipant::serves(const std::string& robot_id) {
+  if (!shard_) return true;
+  const StampNs now_ns = dds::steady_clock_ns();
+  check_shard_stall(now_ns);
+  // Serves once alive to the others (its first assertion after settling), not a tick before.
+  if (shard_asserted_ns_ && shard_->serves(robot_id, now_ns)) return true;
+  ++other_shard_samples_;
+  return false;
+}
+
+void LocalizerParticipant::announce_shard() {
+  shard_writer_ = participant_.writer<msg::LocalizerShardPubSubType>(dds::kLocalizerShardTopic, &shard_matches_);
+  const eprosima::fastdds::dds::LivelinessQosPolicy liveliness = shard_writer_->get_qos().liveliness();
+  if (liveliness.kind != eprosima::fastdds::dds::MANUAL_BY_TOPIC_LIVELINESS_QOS ||
+      liveliness.lease_duration == eprosima::fastrtps::c_TimeInfinite) {
+    // Without a finite lease asserted by this localizer, a dead or hung shard would keep its
+    // robots for good: the profile was edited, refuse to start.
+    throw dds::DdsError("profile localizer_shard.writer: a shard needs manual-by-topic liveliness with a finite lease");
+  }
+  shard_lease_ns_ = static_cast<StampNs>(liveliness.lease_duration.seconds) * kNsPerSecond +
+                    static_cast<StampNs>(liveliness.lease_duration.nanosec);
+  shard_.emplace(dds::writer_id(shard_writer_->get_instance_handle()), core_.estimator_name(), kShardSettleNs);
+}
+
+void LocalizerParticipant::listen_to_shards() {
+  // Each event under the lock; a change of the live shards hands robots over at once and says so
+  // in the Diagnostics at once, so that the shard taking a robot over does not see it listed by
+  // this one for up to a period (a serving conflict).
+  auto changed = [this](auto change) {
+    bool moved = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      const bool stalled = check_shard_stall(dds::steady_clock_ns());  // robots from before a stall go first
+      moved = change();
+      if (moved) release_robots_not_served();
+      moved = moved || stalled;
+    }
+    if (moved) diagnostics_->publish_now();
+  };
+  dds::ReaderEvents<msg::LocalizerShard> events;
+  events.on_writer_gone = [this, changed](const std::string& writer) {
+    changed([&] {
+      const bool moved = shard_->on_shard_lost(writer);
+      // Its Diagnostics may go on listing its robots for seconds (a killed process's last report):
+      // not a conflict with the shard taking them over.
+      if (moved) conflicts_.on_peers_gone(dds::participant_of_writer(writer), dds::steady_clock_ns());
+      return moved;
+    });
+  };
+  events.on_writer_alive = [this, changed](const std::string& writer) {
+    changed([&] { return shard_->on_shard_alive(writer); });
+  };
+  events.on_writer_unmatched = [this, changed](const std::string& writer) {
+    changed([&] { return shard_->on_shard_gone(writer); });  // a restarted shard comes with a new id
+  };
+  readers_.push_back(participant_.subscribe_with_info<msg::LocalizerShardPubSubType>(
+      dds::kLocalizerShardTopic,
+      [this, changed](const msg::LocalizerShard& m, const eprosima::fastdds::dds::SampleInfo& info) {
+        const std::string writer = dds::writer_id(info.publication_handle);
+        changed([&] {
+          // Bad announcements are refused and counted; membership keys on the writer alone.
+          if (m.shard() != writer) return refuse_announcement("localizer_shard.id_not_its_writer");
+          if (m.estimator().size() > kMaxShardTextLength || m.participant().size() > kMaxShardTextLength) {
+            return refuse_announcement("localizer_shard.text_too_long");
+          }
+          switch (shard_->on_announcement(writer, m.estimator())) {
+            case ShardMembership::Announcement::kLiveSetChanged:
+              return true;
+            case ShardMembership::Announcement::kEstimatorChanged:
+              return refuse_announcement("localizer_shard.estimator_changed");
+            case ShardMembership::Announcement::kNoChange:
+              break;
+          }
+          return false;
+        });
+      },
+      events));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    shard_->start_settling(dds::steady_clock_ns());  // now that it hears the others
+  }
+  const eprosima::fastdds::dds::LivelinessQosPolicy heard = readers_.back()->get_qos().liveliness();
+  if (heard.kind != eprosima::fastdds::dds::MANUAL_BY_TOPIC_LIVELINESS_QOS ||
+      !(shard_writer_->get_qos().liveliness().lease_duration <= heard.lease_duration)) {
+    // Incompatible with its own writer: the shards would never match, each serving every robot.
+    throw dds::DdsError(
+        "profile localizer_shard.reader: manual-by-topic liveliness with a lease at least the writer's");
+  }
+  shard_liveliness_ = std::make_unique<dds::PeriodicTask>(
+      std::max(std::chrono::milliseconds(1),
+               std::chrono::milliseconds(shard_lease_ns_ / kShardAssertionsPerLease / kNsPerMillisecond)),
+      [this] { keep_shard_alive(); });
+}
+
+bool LocalizerParticipant::refuse_announcement(const std::string& reason) {
+  ++shard_announcements_refused_[reason];
+  return false;
+}
+
+void LocalizerParticipant::keep_shard_alive() {
+  bool announce = false, assert_now = false;
+  {
+    // Only a localizer that can take its lock asserts: one stuck under it (a hung estimator) is
+    // taken for gone, and its robots served by the others.
+    std::lock_guard<std::mutex> lock(mutex_);
+    const StampNs now_ns = dds::steady_clock_ns();
+    check_shard_stall(now_ns);
+    // Alive to the others only once settled: they hand its share over as it starts serving it.
+    if (shard_->settled(now_ns)) {
+      assert_now = true;
+      // Announced once settled, and again whenever a reader matched since: a shard that lost and
+      // found it again (a partition, a stall past the participant's lease) may not be sent a
+      // sample it was sent before.
+      const bool new_reader = shard_matches_.matched_since_asked();
+      if (!shard_announced_ || new_reader) announce = shard_announced_ = true;
+      shard_asserted_ns_ = now_ns;
+    }
+  }
+  // Outside the lock: Fast DDS may tell this participant's own reader at once, whose callback
+  // takes it.
+  if (announce) {
+    msg::LocalizerShard m;
+    m.shard(shard_->self());
+    m.participant(participant_.name());
+    m.estimator(core_.estimator_name());
+    shard_writer_->write(&m);
+  }
+  if (assert_now) shard_writer_->assert_liveliness();
+}
+
+bool LocalizerParticipant::check_shard_stall(StampNs now_ns) {
+  // Past the lease less one assertion period: the others' lease runs from when an assertion
+  // reached them, a little after it was sent.
+  const StampNs stalled_after_ns = shard_lease_ns_ - shard_lease_ns_ / kShardAssertionsPerLease;
+  if (!shard_ || !shard_asserted_ns_ || now_ns - *shard_asserted_ns_ <= stalled_after_ns) return false;
+  // Stalled past its lease (stopped, starved, stuck): the others took its robots over and served
+  // them since, while its estimators missed that time. Every robot goes; it settles again,
+  // silent meanwhile, so that the others serve on until it is alive again and then hand its share
+  // back at once, to fresh estimators. Told here by the first sample after the stall as well as
+  // by the liveliness task, whichever runs first.
+  for (const std::string& robot_id : core_.robot_ids()) release_robot(robot_id);
+  conflicts_.set_own_robots({}, now_ns);
+  robots_told_ = 0;
+  ++shard_stalls_;
+  shard_asserted_ns_.reset();
+  shard_->start_settling(now_ns);
+  return true;
+}
+
+void LocalizerParticipant::release_robot(const std::string& robot_id) {
+  core_.release_robot(robot_id);
+  odometry_sequence_.erase(robot_id);
+  plan_sent_ns_.erase(robot_id);
+  ++robots_handed_over_;
+}
+
+void LocalizerParticipant::release_robots_not_served() {
+  const StampNs now_ns = dds::steady_clock_ns();
+  for (const std::string& robot_id : core_.robot_ids()) {
+    if (!shard_->serves(robot_id, now_ns)) release_robot(robot_id);
+  }
+  conflicts_.set_own_robots(core_.robot_ids(), now_ns);
+  robots_told_ = core_.robot_count();
 }
 
 void LocalizerParticipant::on_peer_diagnostics(const msg::Diagnostics& d, const std::string& writer) {
@@ -203,30 +392,34 @@ void LocalizerParticipant::on_peer_diagnostics(const msg::Diagnostics& d, const 
 void LocalizerParticipant::on_odometry(const msg::Odometry& m) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    // Increments the bus dropped (a history too short for a stalled reader): counted, since an
-    // estimator integrating odometry cannot see that a 10 ms step is missing.
-    if (core_.serves(m.robot_id())) {
-      auto [last, first] = odometry_sequence_.try_emplace(m.robot_id(), m.sequence_number());
-      const std::uint64_t seq = m.sequence_number();
-      const std::uint64_t distance = seq > last->second ? seq - last->second : last->second - seq;
-      if (!first && distance > kSequenceRestart) {
-        // Far back (a restarted gateway numbering from 0 again) or far ahead (another writer, a
-        // corrupted number): a new numbering, not that many lost samples.
-        last->second = seq;
-        ++sequence_restarts_;
-      } else if (!first && seq > last->second) {
-        lost_increments_ += seq - last->second - 1;
-        last->second = seq;
-      }
-    }
-    if (auto out = core_.on_odometry(m.robot_id(), dds::from_msg(m))) {
-      publish(*out);
-      publish_firing_plan(m.robot_id(), out->estimate.stamp_ns);
-    }
-    share_calibration();
+    if (serves(m.robot_id())) fuse_odometry(m);
     newest_odometry_stamp_ns_ = std::max(newest_odometry_stamp_ns_.load(), m.stamp_ns());
   }
   ++odometry_processed_;
+}
+
+void LocalizerParticipant::fuse_odometry(const msg::Odometry& m) {
+  // Increments the bus dropped (a history too short for a stalled reader): counted, since an
+  // estimator integrating odometry cannot see that a 10 ms step is missing.
+  if (core_.serves(m.robot_id())) {
+    auto [last, first] = odometry_sequence_.try_emplace(m.robot_id(), m.sequence_number());
+    const std::uint64_t seq = m.sequence_number();
+    const std::uint64_t distance = seq > last->second ? seq - last->second : last->second - seq;
+    if (!first && distance > kSequenceRestart) {
+      // Far back (a restarted gateway numbering from 0 again) or far ahead (another writer, a
+      // corrupted number): a new numbering, not that many lost samples.
+      last->second = seq;
+      ++sequence_restarts_;
+    } else if (!first && seq > last->second) {
+      lost_increments_ += seq - last->second - 1;
+      last->second = seq;
+    }
+  }
+  if (auto out = core_.on_odometry(m.robot_id(), dds::from_msg(m))) {
+    publish(*out);
+    publish_firing_plan(m.robot_id(), out->estimate.stamp_ns);
+  }
+  share_calibration();
 }
 
 void LocalizerParticipant::publish_firing_plan(const std::string& robot_id, StampNs stamp_ns) {
@@ -245,6 +438,8 @@ void LocalizerParticipant::publish_firing_plan(const std::string& robot_id, Stam
 }
 
 void LocalizerParticipant::publish(const LocalizerOutput& out) {
+  // A sample taken before a stall and fused after it: its robot was just released, no pose.
+  if (check_shard_stall(dds::steady_clock_ns())) return;
   if (core_.robot_count() != robots_told_) {  // a new robot: is it contested? (once per robot)
     conflicts_.set_own_robots(core_.robot_ids(), dds::steady_clock_ns());
     robots_told_ = core_.robot_count();
@@ -291,6 +486,7 @@ void LocalizerParticipant::share_calibration() {
 
 msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   std::lock_guard<std::mutex> lock(mutex_);
+  check_shard_stall(dds::steady_clock_ns());  // never the robots held through a stall
   std::vector<std::string> robots = core_.robot_ids();
   conflicts_.set_own_robots(robots, dds::steady_clock_ns());  // and drops the peers gone silent
   const PoseStatus worst = core_.worst_status();
@@ -326,6 +522,21 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
     message += "; beacon map replaced " + std::to_string(core_.beacon_map_changes()) +
                " time(s), every robot restarted on it";
   }
+  if (shard_) {
+    const StampNs now_ns = dds::steady_clock_ns();
+    message += "; shard: " + std::to_string(shard_->live_shards()) + " live shard(s) of " + core_.estimator_name() +
+               (shard_->settled(now_ns) ? "" : ", settling (serving none yet)") + ", " +
+               std::to_string(robots_handed_over_) + " robot(s) released, " +
+               std::to_string(other_shard_samples_) +
+               " sample(s) of robots it does not serve (other shards', or while settling)";
+    if (shard_stalls_) {
+      message += ", " + std::to_string(shard_stalls_) + " stall(s) past its lease (every robot released)";
+    }
+    if (shard_->other_estimator_shards()) {
+      // Another estimator's fleet serves the same robots: the serving conflicts say so.
+      message += ", " + std::to_string(shard_->other_estimator_shards()) + " shard(s) of other estimators";
+    }
+  }
   if (plan_writer_) message += "; selective activation: " + std::to_string(plans_sent_) + " firing plan(s) sent";
   if (!core_.calibration().groups.empty()) {
     message += "; beacon calibration: " + std::to_string(core_.calibration().groups.size()) + " group(s)";
@@ -358,6 +569,7 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   counts.reject("calibration_file.write_failed", calibration_saves_failed_);
   counts.reject("calibration.too_many_beacons", calibrations_refused_too_large_);
   counts.reject("calibration.other_frame", calibrations_refused_other_frame_);
+  for (const auto& [reason, n] : shard_announcements_refused_) counts.reject(reason, n);
   auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, deadline_misses_.load(),
                                  status, message);
   d.writers_lost(odometry_writers_lost_.load() + range_writers_lost_.load());

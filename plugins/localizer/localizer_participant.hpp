@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "beaconloc/dds/participant.hpp"
 #include "localizer_core.hpp"
 #include "serving_conflicts.hpp"
+#include "shard_membership.hpp"
 
 namespace beaconloc {
 
@@ -33,6 +35,11 @@ struct LocalizerParticipantOptions {
   // that may reach the robot (LocalizerCore::firing_plan), every kFiringPlanPeriodNs of data time
   // while the robot has a pose. Off: the gateways fire every beacon.
   bool selective_activation = false;
+  // A shard of a fleet's localizers (issue 19): it announces itself on localizer_shard and
+  // serves only the robots that ShardAssignment gives it among the live shards of its
+  // estimator, taking over the robots of a shard that dies or hangs (liveliness, 0.5 s) and
+  // handing robots to a shard that joins. Off: it serves every robot (or --robot's one).
+  bool shard = false;
 };
 
 // A calibration file that exists and cannot be used: the start is refused, with the reason.
@@ -59,6 +66,16 @@ class LocalizerParticipant {
     return core_.has_beacon_map();
   }
   StampNs newest_odometry_stamp_ns() const { return newest_odometry_stamp_ns_.load(); }
+  // Shards: the live shards it counts (itself among them; 0 when not a shard), and the robots it
+  // serves now. For benchmarks in the same process.
+  std::size_t live_shards() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return shard_ ? shard_->live_shards() : 0;
+  }
+  std::size_t robots_served() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return core_.robot_count();
+  }
   std::uint64_t lost_increments() {
     std::lock_guard<std::mutex> lock(mutex_);
     return lost_increments_;
@@ -67,9 +84,26 @@ class LocalizerParticipant {
  private:
   msg::Diagnostics diagnostics_snapshot();
   void on_odometry(const msg::Odometry& odometry);
+  void fuse_odometry(const msg::Odometry& odometry);  // a robot it serves, under mutex_
   void publish(const LocalizerOutput& out);  // under mutex_
   void publish_firing_plan(const std::string& robot_id, StampNs stamp_ns);  // under mutex_
   void on_peer_diagnostics(const msg::Diagnostics& d, const std::string& writer);
+  // Shards: whether this localizer serves the robot now (always, unless a shard); a sample of a
+  // robot another shard serves is counted and dropped. Under mutex_.
+  bool serves(const std::string& robot_id);
+  // Shards: its writer and membership, before any sample (announce_shard); then, once every
+  // reader is up, listens to the others, settles, and announces itself (listen_to_shards).
+  void announce_shard();
+  void listen_to_shards();
+  // On its own thread, lease / 5: once settled, announces (the first time) and asserts the
+  // liveliness; after a stall past the lease releases every robot (check_shard_stall, under mutex_).
+  void keep_shard_alive();
+  bool check_shard_stall(StampNs now_ns);  // whether it found a stall (robots released); under mutex_
+  bool refuse_announcement(const std::string& reason);  // counted; false (no change). Under mutex_.
+  // A robot another shard serves now, or one this shard held through a stall: its estimator and
+  // bookkeeping go. Under mutex_.
+  void release_robot(const std::string& robot_id);
+  void release_robots_not_served();  // after the live shards changed; under mutex_
   // The site's calibration, when it changed (a robot calibrated a group, another localizer's
   // arrived): on the bus, and into the calibration file. Under mutex_.
   void share_calibration();
@@ -109,14 +143,38 @@ class LocalizerParticipant {
   std::string calibration_save_error_;             // the last failure, while the newest is unsaved
   std::map<std::string, StampNs> plan_sent_ns_;    // stamp of the pose each robot's last plan came from
   std::uint64_t plans_sent_ = 0;
-  // The entities, owned: the readers, declared last, stop first, before what they use goes.
+  std::optional<ShardMembership> shard_;      // with options_.shard
+  std::uint64_t other_shard_samples_ = 0;     // samples of robots it does not serve (serves())
+  std::uint64_t robots_handed_over_ = 0;      // robots released (to another shard, or after a stall)
+  std::uint64_t shard_stalls_ = 0;            // stalls past its lease
+  std::map<std::string, std::uint64_t> shard_announcements_refused_;  // by reason
+  StampNs shard_lease_ns_ = 0;                // its announcement writer's (topics.xml)
+  bool shard_announced_ = false;
+  std::optional<StampNs> shard_asserted_ns_;  // the newest assertion; none while settling
+  // Readers matched by the announcement writer since last asked: it announces again.
+  class MatchListener : public eprosima::fastdds::dds::DataWriterListener {
+   public:
+    void on_publication_matched(eprosima::fastdds::dds::DataWriter*,
+                                const eprosima::fastdds::dds::PublicationMatchedStatus& s) override {
+      if (s.current_count_change > 0) matched_ = true;
+    }
+    bool matched_since_asked() { return matched_.exchange(false); }
+
+   private:
+    std::atomic<bool> matched_{false};
+  };
+  MatchListener shard_matches_;  // outlives shard_writer_
+  // The entities, owned, declared last and so gone first (the shard's liveliness task, then the
+  // readers, then the writers), before what they use goes.
   dds::Participant participant_;
   dds::Writer pose_writer_;
   dds::Writer state_writer_;  // EstimatorState: what the estimator holds beside the pose
   dds::Writer calibration_writer_;  // BeaconCalibration: the site's calibrated beacon groups
   dds::Writer plan_writer_;         // FiringPlan, with selective activation
+  dds::Writer shard_writer_;        // LocalizerShard, with options_.shard
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
   std::vector<dds::Reader> readers_;
+  std::unique_ptr<dds::PeriodicTask> shard_liveliness_;  // asserts shard_writer_'s; stops first
 };
 
 }  // namespace beaconloc

@@ -1,5 +1,7 @@
 #include "serving_conflicts.hpp"
 
+#include <iterator>
+
 namespace beaconloc {
 
 void ServingConflicts::set_own_robots(const std::vector<std::string>& robots, StampNs now_ns) {
@@ -19,6 +21,13 @@ void ServingConflicts::on_peer_report(const std::string& peer, const std::string
 
 void ServingConflicts::on_peer_gone(const std::string& peer, StampNs now_ns) {
   peers_.erase(peer);
+  find_conflicts(now_ns);
+}
+
+void ServingConflicts::on_peers_gone(const std::string& prefix, StampNs now_ns) {
+  for (auto it = peers_.begin(); it != peers_.end();) {
+    it = it->first.compare(0, prefix.size(), prefix) == 0 ? peers_.erase(it) : std::next(it);
+  }
   find_conflicts(now_ns);
 }
 

@@ -28,6 +28,9 @@ class ServingConflicts {
                       const std::vector<std::string>& robots, StampNs now_ns);
   // The peer stopped, or DDS lost it.
   void on_peer_gone(const std::string& peer, StampNs now_ns);
+  // Every peer whose id begins with prefix is gone (its participant died: a localizer shard's
+  // loss is known from its announcement's liveliness long before its Diagnostics fall silent).
+  void on_peers_gone(const std::string& prefix, StampNs now_ns);
   // Drops the peers silent at now_ns (call now and then: the Diagnostics period).
   void refresh(StampNs now_ns);
 

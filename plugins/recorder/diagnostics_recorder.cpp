@@ -62,7 +62,9 @@ void DiagnosticsRecorder::read(bool fresh) const {
       if (fresh && info.valid_data) {
         // (The listener and reports() may read two samples at once: the newer one stays.)
         if (it == entries_.end() || !(info.source_timestamp < it->second.sent)) {
-          entries_[info.instance_handle] = Entry{data[i], info.source_timestamp, now, info.instance_state};
+          entries_[info.instance_handle] =
+              Entry{data[i], info.source_timestamp, now, info.instance_state,
+                    dds::participant_of_writer(dds::writer_id(info.publication_handle))};
         }
       } else if (it != entries_.end()) {
         it->second.state = info.instance_state;  // a participant never heard from is not shown
@@ -80,8 +82,8 @@ std::map<std::string, ParticipantReport> DiagnosticsRecorder::reports() const {
   std::map<std::string, ParticipantReport> out;
   for (const auto& [handle, e] : entries_) {
     const auto age = now - e.heard;
-    out[e.last.participant()] = {e.last, liveness_of(e.state, age),
-                                 std::chrono::duration<double>(age).count()};
+    out[e.last.participant()] = {e.last, liveness_of(e.state, age), std::chrono::duration<double>(age).count(),
+                                 e.participant_id};
   }
   return out;
 }

@@ -33,6 +33,9 @@ struct ParticipantReport {
   msg::Diagnostics last;  // its newest report
   Liveness liveness = Liveness::kAlive;
   double heard_s_ago = 0.0;  // since that report arrived
+  // Its participant's id (dds::participant_of_writer of the report's writer): the other
+  // writers of that participant (a localizer's poses) begin with it.
+  std::string participant_id;
 };
 
 // What the instance state and the age of the newest report say (age in steady-clock time).
@@ -52,6 +55,7 @@ class DiagnosticsRecorder {
     eprosima::fastrtps::rtps::Time_t sent;  // its source timestamp
     std::chrono::steady_clock::time_point heard;
     eprosima::fastdds::dds::InstanceStateKind state;
+    std::string participant_id;
   };
   class Listener : public eprosima::fastdds::dds::DataReaderListener {
    public:

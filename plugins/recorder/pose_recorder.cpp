@@ -11,10 +11,10 @@ PoseRecorder::PoseRecorder(const dds::DdsOptions& dds, Keep keep)
   reader_ = participant_.subscribe_with_info<msg::PoseEstimatePubSubType>(
       dds::kPoseEstimateTopic,
       [this](const msg::PoseEstimate& m, const eprosima::fastdds::dds::SampleInfo& info) {
-        RecordedPose p{{m.robot_id(), dds::from_msg(m), m.estimator()}, std::chrono::steady_clock::now()};
-        std::lock_guard<std::mutex> lock(mutex_);
         const std::string writer = dds::writer_id(info.publication_handle);
-        const PoseTally::Added added = tally_.add(p, writer);
+        RecordedPose p{{m.robot_id(), dds::from_msg(m), m.estimator()}, std::chrono::steady_clock::now(), writer};
+        std::lock_guard<std::mutex> lock(mutex_);
+        const PoseTally::Added added = tally_.add(p);
         if (keep_ != Keep::kEveryPose || added == PoseTally::Added::kNonFinite) return;
         auto [newest, first] = newest_of_writer_.try_emplace({p.row.robot_id, writer}, poses_.size());
         if (!first && added == PoseTally::Added::kCorrection) {

@@ -16,10 +16,13 @@ namespace beaconloc {
 struct RecordedPose {
   EstimateRow row;
   std::chrono::steady_clock::time_point received;
+  std::string writer;  // dds::writer_id of the writer it came from
 };
 
-// Two writers whose poses for one robot arrive within this of each other serve it at once (a
-// localizer writes one per odometry sample, 100 Hz); a writer replaced by another is no conflict.
+// Two writers serve one robot at once when their poses alternate: a writer's pose arrives after
+// another's, within this of its own previous one (a localizer writes one per odometry sample,
+// 100 Hz). A writer replaced by another (a localizer restarted, a shard's robot taken over or
+// handed to a new shard) never writes after its successor: no conflict.
 inline constexpr std::chrono::milliseconds kConcurrentWritersWithin{1000};
 
 struct PoseWriter {
@@ -35,7 +38,9 @@ struct RobotPoses {
   std::uint64_t non_finite = 0;  // refused: not publishable() (a non-finite number, a broken covariance)
   std::map<std::string, PoseWriter> writers;  // by writer id (one per localizer)
   bool had_conflict = false;                  // two writers at once, ever
-  // The writers heard within kConcurrentWritersWithin before `now`: more than one is a conflict.
+  std::optional<std::chrono::steady_clock::time_point> last_alternation;  // of the newest conflict
+  // The writers serving the robot at `now`: the newest pose's, and while their poses alternated
+  // within kConcurrentWritersWithin, every writer heard within it (more than one: a conflict).
   std::vector<const PoseWriter*> current_writers(std::chrono::steady_clock::time_point now) const;
 };
 
@@ -46,8 +51,7 @@ class PoseTally {
     kCorrection,  // at the stamp of its writer's newest pose of the robot: it replaces that one
     kNonFinite,   // refused, counted
   };
-  // writer: the id of the writer the pose came from (dds::writer_id).
-  Added add(const RecordedPose& pose, const std::string& writer);
+  Added add(const RecordedPose& pose);
   const std::map<std::string, RobotPoses>& robots() const { return robots_; }
   std::uint64_t poses() const { return poses_; }                         // over every robot
   const std::optional<RecordedPose>& newest() const { return newest_; }  // of any robot

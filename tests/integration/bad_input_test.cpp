@@ -84,7 +84,7 @@ TEST_F(BadInput, DecoderRefusesEveryBadTofByReason) {
   // One reader takes them in order: the last one, good, is the 4th accepted.
   const auto d = wait_for_diagnostics(diagnostics, kDecoder,
                                       [](const msg::Diagnostics& r) { return r.accepted() >= 4; });
-  print_report(kDecoder, ParticipantReport{d}, std::cout);
+  print_report(kDecoder, ParticipantReport{d, Liveness::kAlive, 0.0, {}}, std::cout);
   EXPECT_EQ(d.accepted(), 4u);
   EXPECT_EQ(rejected_count(d, "non_finite_tof"), 2u);
   EXPECT_EQ(rejected_count(d, "negative_tof"), 1u);
@@ -190,7 +190,7 @@ TEST_F(BadInput, LocalizerRefusesEveryBadSampleByReason) {
   const auto d = wait_for_diagnostics(diagnostics, kRangeEkfLocalizer, [](const msg::Diagnostics& r) {
     return rejected_count(r, "range.ahead_of_odometry") >= 1;
   });
-  print_report("localizer", ParticipantReport{d}, std::cout);
+  print_report("localizer", ParticipantReport{d, Liveness::kAlive, 0.0, {}}, std::cout);
   EXPECT_EQ(d.accepted(), good_odometry + 1);
   EXPECT_EQ(rejected_count(d, "odometry.duplicate_odometry"), 1u);
   EXPECT_EQ(rejected_count(d, "odometry.out_of_order_odometry"), 1u);

@@ -1,10 +1,16 @@
 # Fails when a file of the DDS-free core includes a DDS header: the SDK core, the estimators,
-# the decoder and localizer cores and the simulator.
+# the decoder and localizer cores (with the shards' and conflicts' bookkeeping), the monitor's
+# pose tally and fleet view, the evaluation, and the simulator.
 file(GLOB_RECURSE files
   ${ROOT}/plugins/sdk/include/beaconloc/core/*
   ${ROOT}/plugins/sdk/src/*
   ${ROOT}/plugins/localizer/estimators/*
   ${ROOT}/plugins/localizer/localizer_core.*
+  ${ROOT}/plugins/localizer/shard_membership.*
+  ${ROOT}/plugins/localizer/serving_conflicts.*
+  ${ROOT}/plugins/recorder/pose_tally.*
+  ${ROOT}/plugins/eval/*
+  ${ROOT}/plugins/cli/fleet_view.*
   ${ROOT}/plugins/decoder/tof_decoder.*
   ${ROOT}/plugins/gateway/sim/*)
 list(LENGTH files count)

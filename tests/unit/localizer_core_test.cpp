@@ -68,6 +68,28 @@ TEST(LocalizerCore, IgnoresOtherRobotsWhenFilteredAndCountsThem) {
   EXPECT_EQ(core.robot_count(), 0u);
 }
 
+// A robot handed to another shard: its estimator goes; its next sample starts it afresh.
+TEST(LocalizerCore, AReleasedRobotIsForgottenAndStartsAfreshIfItComesBack) {
+  EstimatorConfig config;
+  config.receivers = ReceiverArray::on_circle(0.19, 3);
+  LocalizerCore core("range_ekf", config);
+  OdometrySample o;
+  o.wheel_base_m = 0.33;
+  core.on_odometry("a", o);
+  core.on_odometry("b", o);
+  ASSERT_EQ(core.robot_count(), 2u);
+  EXPECT_TRUE(core.release_robot("a"));
+  EXPECT_FALSE(core.release_robot("a"));
+  EXPECT_EQ(core.robot_ids(), std::vector<std::string>{"b"});
+  EXPECT_EQ(core.estimator("a"), nullptr);
+  core.on_ranges_silent("a");  // a deadline told late: no robot made for it
+  core.on_odometry_deadline_missed("a");
+  EXPECT_EQ(core.robot_count(), 1u);
+  core.on_odometry("a", o);
+  EXPECT_EQ(core.robot_count(), 2u);
+  EXPECT_FALSE(core.startup_wait("a") == std::nullopt);  // initializing again, from nothing
+}
+
 // A robot on the default scenario's data, localized, through its LocalizerCore.
 struct LocalizedRobot {
   sim::Scenario scenario = sim::default_scenario();

@@ -72,5 +72,20 @@ TEST(ServingConflicts, OwnRobotsChangingFindTheConflictAndEveryPeerIsNamed) {
   EXPECT_TRUE(c.contested("r1"));
 }
 
+// A localizer shard lost (its announcement's liveliness) takes its participant's peer ids with it:
+// the Diagnostics of a killed process may go on listing its robots for seconds.
+TEST(ServingConflicts, EveryPeerOfAParticipantGoneAtOnce) {
+  ServingConflicts c(kSilentNs);
+  c.set_own_robots({"r1"}, 0);
+  c.on_peer_report("0102aa-diagnostics", "shard-1", {"r1"}, 0);
+  c.on_peer_report("0103bb-diagnostics", "shard-2", {"r1"}, 0);
+  ASSERT_EQ(c.describe(), "robot r1 also served by shard-1, shard-2");
+  c.on_peers_gone("0102", 10);
+  EXPECT_TRUE(c.contested("r1"));
+  EXPECT_EQ(c.describe(), "robot r1 also served by shard-2");
+  c.on_peers_gone("0103", 20);
+  EXPECT_FALSE(c.contested("r1"));
+}
+
 }  // namespace
 }  // namespace beaconloc

@@ -79,6 +79,9 @@ class LocalizerCommand : public Command {
     dds_option_set(dds_).add_to(app_);
     localizer_option_set(settings_, true).add_to(app_);
     app_->add_flag("--list-estimators", list_estimators_, "print the estimators and exit");
+    app_->add_flag("--shard", shard_,
+                   "one shard of a fleet's localizers: serve the share of the robots that falls to it among "
+                   "the live shards of its estimator, take over a dead shard's robots");
   }
   int execute() override {
     if (list_estimators_) {
@@ -87,8 +90,11 @@ class LocalizerCommand : public Command {
       }
       return 0;
     }
+    if (shard_ && !settings_.robot.empty()) {
+      throw std::invalid_argument("--shard serves a share of every robot; --robot serves one: not both");
+    }
     LocalizerParticipant participant(dds_, LocalizerCore(settings_.estimator, settings_.config(), settings_.robot),
-                                     {settings_.calibration_file, settings_.selective_activation()});
+                                     {settings_.calibration_file, settings_.selective_activation(), shard_});
     run_until_stopped();
     return 0;
   }
@@ -97,6 +103,7 @@ class LocalizerCommand : public Command {
   dds::DdsOptions dds_;
   LocalizerSettings settings_;
   bool list_estimators_ = false;
+  bool shard_ = false;
 };
 
 class BridgeCommand : public Command {
@@ -152,6 +159,9 @@ class MonitorCommand : public Command {
         ->transform(real_in(0.0, kMaxDurationS));
     app_->add_option("--truth", options_.truth_file, "ground truth CSV written by the gateway");
     app_->add_option("--out", options_.out_file, "write every pose to this CSV at the end");
+    app_->add_flag("--fleet", options_.fleet,
+                   "every second, a row per robot: pose status, pose rate, age, its gateway's rejections and the "
+                   "localizer (shard) serving it");
   }
   int execute() override { return run_monitor(options_); }
 

@@ -12,6 +12,9 @@ DiagnosticsPublisher::DiagnosticsPublisher(Participant& participant,
       task_(std::make_unique<PeriodicTask>(kDiagnosticsPeriod, [this] { publish_now(); })) {}
 
 void DiagnosticsPublisher::publish_now() {
+  // One report at a time, built and written together: the periodic task's and one asked for
+  // (a localizer shard's change) never cross, an older report written last.
+  std::lock_guard<std::mutex> lock(publish_mutex_);
   msg::Diagnostics d = snapshot_();
   // Samples no type support could read (Fast DDS dropped them), whatever the participant.
   if (const std::uint64_t undecodable = participant_.undecodable_samples()) {

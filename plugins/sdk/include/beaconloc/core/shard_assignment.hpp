@@ -6,7 +6,6 @@
 // others; a shard that joins takes about 1/n of the robots, each from the shard that had it.
 // DDS-free; the hash is this file's own (FNV-1a over the bytes as unsigned, then a 64-bit mix),
 // the same on every host and build, so that shards of different builds or machines agree.
-// Groundwork of issue 19's shards: nothing uses it yet.
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -16,7 +15,8 @@ namespace beaconloc {
 
 class ShardAssignment {
  public:
-  // self: this shard's id, unique among the shards (its participant's GUID); live from the start.
+  // self: this shard's id, unique among the shards (its announcement writer's GUID, as text:
+  // ShardMembership); live from the start.
   explicit ShardAssignment(std::string self);
 
   // The live shards as now known, any order: self is always among them (none given: itself

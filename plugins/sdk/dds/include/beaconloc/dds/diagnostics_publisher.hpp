@@ -9,6 +9,7 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "beaconloc/dds/participant.hpp"
@@ -34,6 +35,7 @@ class DiagnosticsPublisher {
  private:
   const Participant& participant_;
   std::function<msg::Diagnostics()> snapshot_;
+  std::mutex publish_mutex_;  // one report built and written at a time
   Writer writer_;
   std::unique_ptr<PeriodicTask> task_;
 };

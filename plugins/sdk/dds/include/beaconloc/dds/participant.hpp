@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "beaconloc/core/deadline_watch.hpp"
+#include "beaconloc/core/participant_id.hpp"
 #include "beaconloc/dds/checked_type.hpp"
 #include "beaconloc/dds/periodic_task.hpp"
 #include "beaconloc/dds/topics.hpp"
@@ -68,6 +69,11 @@ struct ReaderEvents {
   // A writer of the topic is gone: unmatched (deleted, its participant left or was lost) or its
   // liveliness lost; the id is writer_id() of its samples' SampleInfo::publication_handle.
   std::function<void(const std::string& writer)> on_writer_gone;
+  // A writer's liveliness is asserted again after its loss (a stall longer than the lease); also
+  // told at its first assertion or sample.
+  std::function<void(const std::string& writer)> on_writer_alive;
+  // A writer unmatched for good (deleted, its participant left or was dropped), after on_writer_gone.
+  std::function<void(const std::string& writer)> on_writer_unmatched;
   // A sample without data: its writer disposed or unregistered the instance (info.instance_state).
   std::function<void(const eprosima::fastdds::dds::SampleInfo& info)> on_instance_ended;
 };
@@ -82,6 +88,8 @@ inline std::string writer_id(const eprosima::fastdds::dds::InstanceHandle_t& pub
   }
   return s.str();
 }
+
+using beaconloc::participant_of_writer;  // core/participant_id.hpp
 
 // Takes every valid sample a reader has and hands it to a callback with its SampleInfo; keeps
 // the topic's deadline per instance (TopicSpec::deadline_ns: a DeadlineWatch checked on a thread
@@ -135,8 +143,9 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
   }
   void on_subscription_matched(eprosima::fastdds::dds::DataReader*,
                                const eprosima::fastdds::dds::SubscriptionMatchedStatus& s) override {
-    if (events_.on_writer_gone && s.current_count_change < 0) {
-      events_.on_writer_gone(writer_id(s.last_publication_handle));
+    if (s.current_count_change < 0) {
+      if (events_.on_writer_gone) events_.on_writer_gone(writer_id(s.last_publication_handle));
+      if (events_.on_writer_unmatched) events_.on_writer_unmatched(writer_id(s.last_publication_handle));
     }
   }
   void on_liveliness_changed(eprosima::fastdds::dds::DataReader*,
@@ -153,6 +162,9 @@ class SampleListener : public eprosima::fastdds::dds::DataReaderListener {
     }
     if (events_.on_writer_gone && s.not_alive_count_change > 0) {
       events_.on_writer_gone(writer_id(s.last_publication_handle));
+    }
+    if (events_.on_writer_alive && s.alive_count_change > 0) {
+      events_.on_writer_alive(writer_id(s.last_publication_handle));
     }
   }
 

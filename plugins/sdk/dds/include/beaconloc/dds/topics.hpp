@@ -44,5 +44,7 @@ inline constexpr TopicSpec kBeaconCalibrationTopic{"beaconloc/beacon_calibration
 inline constexpr TopicSpec kFiringPlanTopic{"beaconloc/firing_plan", "firing_plan.writer", "firing_plan.reader"};
 inline constexpr TopicSpec kDiagnosticsTopic{"beaconloc/diagnostics", "diagnostics.writer",
                                              "diagnostics.reader"};
+inline constexpr TopicSpec kLocalizerShardTopic{"beaconloc/localizer_shard", "localizer_shard.writer",
+                                                "localizer_shard.reader"};
 
 }  // namespace beaconloc::dds
