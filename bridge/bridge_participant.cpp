@@ -69,18 +69,19 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
   ranges_writer_ = participant_.writer<sensor_msgs::msg::RangePubSubType>(
       {ranges_topic_.c_str(), "ros2.beacon_ranges.writer", ""});
   if (options_.odometry_in) {
-    odometry_in_writer_ = participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic);
+    odometry_in_writer_ = participant_.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, options_.robot_id);
     readers_.push_back(participant_.subscribe<nav_msgs::msg::OdometryPubSubType>(
         {odom_in_topic_.c_str(), "", "ros2.odom.reader"},
         [this](const nav_msgs::msg::Odometry& m) { on_ros_odometry(m); }));
   }
   if (options_.scan_in) {
-    scan_in_writer_ = participant_.writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic);
+    scan_in_writer_ = participant_.robot_writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic, options_.robot_id);
     readers_.push_back(participant_.subscribe<sensor_msgs::msg::LaserScanPubSubType>(
         {scan_in_topic_.c_str(), "", "ros2.scan.reader"},
         [this](const sensor_msgs::msg::LaserScan& m) { on_ros_scan(m); }));
   }
-  initial_pose_writer_ = participant_.writer<msg::InitialPosePubSubType>(dds::kInitialPoseTopic);
+  initial_pose_writer_ =
+      participant_.robot_writer<msg::InitialPosePubSubType>(dds::kInitialPoseTopic, options_.robot_id);
   readers_.push_back(participant_.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
       {initial_pose_topic_.c_str(), "", "ros2.initialpose.reader"},
       [this](const geometry_msgs::msg::PoseWithCovarianceStamped& m) { on_ros_initial_pose(m); }));

@@ -12,7 +12,10 @@ $SUDO apt-get install -y --no-install-recommends \
   libgtest-dev libgmock-dev libbenchmark-dev \
   cyclonedds-dev cyclonedds-tools \
   fastdds-tools iproute2 \
+  openssl libssl-dev \
   clang libclang-rt-14-dev llvm
+# openssl (scripts/deployment-keys.sh: a secured deployment's keys) and libssl-dev (dds/security.cpp
+# checks an enclave's certificates before Fast DDS does; Fast DDS's security plugins link it too).
 # fastdds-tools (fast-discovery-server) and iproute2 (ip netns): the multi-host tests, whose hosts
 # are network namespaces finding each other through two discovery servers (tests/multihost).
 # clang, libclang-rt-14-dev (libFuzzer, ASan and UBSan runtimes) and llvm (llvm-symbolizer, for

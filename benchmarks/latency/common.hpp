@@ -1,10 +1,14 @@
 #pragma once
 // What the latency benchmark's parts share: its settings, the transports, the steady clock in
 // nanoseconds, the stop on a signal (Stopped) and the DDS match counts.
+#include <sys/types.h>
+
 #include <chrono>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+
+#include "beaconloc/dds/participant.hpp"
 
 namespace eprosima::fastdds::dds {
 class DataReader;
@@ -21,9 +25,19 @@ constexpr int kPipelineHops = 3;
 constexpr const char* kRobotId = "robot1";
 
 struct Transport {
-  std::string name;     // shm, udp
+  std::string name;     // shm, udp, shm+security, udp+security
   std::string profile;  // participant profile (examples/qos/loopback.xml)
+  // DDS Security on with this keystore (scripts/deployment-keys.sh): this process and the echo as
+  // enclave kBenchEnclave, the decoder and localizer as their roles'. Empty: off.
+  std::string keystore;
 };
+
+// The benchmark's identity in a secured run (the script's role "bench").
+constexpr const char* kBenchEnclave = "/beaconloc/bench";
+// The options of this process's participants (and the echo's) for transport t.
+dds::DdsOptions bench_dds_options(int domain, const Transport& t);
+// User plus system CPU time a process has used so far (/proc/PID/stat), in seconds.
+double cpu_seconds(pid_t pid);
 
 struct Settings {
   std::string cli;   // the beaconloc executable (decoder and localizer)

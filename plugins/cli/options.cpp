@@ -17,7 +17,13 @@ OptionSet dds_option_set(dds::DdsOptions& o) {
       .text("--participant-profile", o.participant_profile,
             "participant profile of the QoS XML (default: loopback only)", {}, OptionSet::Written::kAlways)
       .texts("--qos", o.extra_qos_files, "extra Fast DDS XML profiles file(s), loaded last",
-             [](CLI::Option* option) { option->check(CLI::ExistingFile); });
+             [](CLI::Option* option) { option->check(CLI::ExistingFile); })
+      .text("--keystore", o.security.keystore,
+            "DDS Security on: the deployment's keystore (scripts/deployment-keys.sh; SROS2 layout)",
+            [](CLI::Option* option) { option->check(CLI::ExistingDirectory); })
+      .text("--enclave", o.security.enclave,
+            "the participant's identity in the keystore (default: its role's, e.g. /beaconloc/decoder; "
+            "not with run or demo, whose participants each take their own)");
   return set;
 }
 

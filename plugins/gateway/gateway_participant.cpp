@@ -22,10 +22,11 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
       throttle_(std::move(throttle)),
       participant_(dds, "beaconloc.gateway." + options_.robot_id),
       map_writer_(participant_.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic)),
-      tof_writer_(participant_.writer<msg::RawTofPubSubType>(dds::kRawTofTopic)),
-      pulse_writer_(participant_.writer<msg::PulseArrivalPubSubType>(dds::kPulseArrivalTopic)),
-      odometry_writer_(participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic)),
-      scan_writer_(participant_.writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic)) {
+      // The robot's measurements, in its partition (a gateway's permissions grant it no other).
+      tof_writer_(participant_.robot_writer<msg::RawTofPubSubType>(dds::kRawTofTopic, options_.robot_id)),
+      pulse_writer_(participant_.robot_writer<msg::PulseArrivalPubSubType>(dds::kPulseArrivalTopic, options_.robot_id)),
+      odometry_writer_(participant_.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, options_.robot_id)),
+      scan_writer_(participant_.robot_writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic, options_.robot_id)) {
   if (source_->honours_firing_plan()) {
     const std::vector<std::uint32_t> every = fire_all(source_->beacon_map());
     scheduler_.emplace(source_->slot_period_ns(), std::set<std::uint32_t>(every.begin(), every.end()));
