@@ -6,11 +6,6 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 
-#include <unistd.h>
-
-#include <fstream>
-#include <sstream>
-
 #include "beaconloc/dds/stop_signal.hpp"
 
 namespace beaconloc::latency {
@@ -29,21 +24,6 @@ dds::DdsOptions bench_dds_options(int domain, const Transport& t) {
   o.participant_profile = t.profile;
   if (!t.keystore.empty()) o.security = {t.keystore, kBenchEnclave};
   return o;
-}
-
-double cpu_seconds(pid_t pid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
-  std::string line;
-  if (!std::getline(in, line)) throw std::runtime_error("cannot read /proc/" + std::to_string(pid) + "/stat");
-  // Fields after the command's closing parenthesis: state is field 3, utime 14, stime 15.
-  std::istringstream rest(line.substr(line.rfind(')') + 2));
-  std::string field;
-  double utime = 0.0, stime = 0.0;
-  for (int i = 3; i <= 15 && rest >> field; ++i) {
-    if (i == 14) utime = std::stod(field);
-    if (i == 15) stime = std::stod(field);
-  }
-  return (utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
 }
 
 int matched_readers(eprosima::fastdds::dds::DataWriter* w) {

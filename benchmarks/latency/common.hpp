@@ -1,8 +1,6 @@
 #pragma once
 // What the latency benchmark's parts share: its settings, the transports, the steady clock in
 // nanoseconds, the stop on a signal (Stopped) and the DDS match counts.
-#include <sys/types.h>
-
 #include <chrono>
 #include <cstdint>
 #include <stdexcept>
@@ -36,8 +34,7 @@ struct Transport {
 constexpr const char* kBenchEnclave = "/beaconloc/bench";
 // The options of this process's participants (and the echo's) for transport t.
 dds::DdsOptions bench_dds_options(int domain, const Transport& t);
-// User plus system CPU time a process has used so far (/proc/PID/stat), in seconds.
-double cpu_seconds(pid_t pid);
+
 
 struct Settings {
   std::string cli;   // the beaconloc executable (decoder and localizer)

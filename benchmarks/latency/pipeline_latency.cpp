@@ -27,6 +27,7 @@
 #include "beaconloc/dds/participant.hpp"
 #include "beaconloc/dds/periodic_task.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
+#include "bench_support.hpp"
 #include "child.hpp"
 #include "sim/scenario.hpp"
 #include "sim/sim_source.hpp"
@@ -187,7 +188,9 @@ PipelineResult run_pipeline(const Settings& st, const Transport& t) {
     const auto wall_start = Clock::now();
     StampNs next_check_ns = kNsPerSecond;
     // The children's CPU over the measured window: read at its first and last step.
-    const auto children_cpu_s = [&] { return cpu_seconds(localizer.pid()) + cpu_seconds(decoder.pid()); };
+    const auto children_cpu_s = [&] {
+      return bench::process_cpu_s(localizer.pid()) + bench::process_cpu_s(decoder.pid());
+    };
     double window_cpu_start_s = 0.0;
     Clock::time_point window_wall_start;
     bool in_window = false;

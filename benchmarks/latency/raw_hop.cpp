@@ -20,6 +20,7 @@
 #include "beaconloc/dds/periodic_task.hpp"
 #include "beaconloc/dds/stop_signal.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
+#include "bench_support.hpp"
 #include "child.hpp"
 
 namespace beaconloc::latency {
@@ -122,7 +123,7 @@ HopResult run_hop(const Settings& st, const Transport& t) {
     for (auto next = begin; next - begin < warmup + measured; next += period) {
       std::this_thread::sleep_until(next);
       const bool timed = Clock::now() - begin >= warmup;
-      if (timed && !echo_cpu_start_s) echo_cpu_start_s = cpu_seconds(echo.pid());
+      if (timed && !echo_cpu_start_s) echo_cpu_start_s = bench::process_cpu_s(echo.pid());
       const auto rtt = round_trip();
       if (timed) {
         ++result.sent;
@@ -137,7 +138,7 @@ HopResult run_hop(const Settings& st, const Transport& t) {
         require_alive(children);
       }
     }
-    if (echo_cpu_start_s) result.echo_cpu_s = cpu_seconds(echo.pid()) - *echo_cpu_start_s;
+    if (echo_cpu_start_s) result.echo_cpu_s = bench::process_cpu_s(echo.pid()) - *echo_cpu_start_s;
     // Back-to-back, for reference (Fast DDS's figure on a hot path, TOOLCHAIN.md's ping-pong).
     const auto b2b = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(st.b2b_hop_s));
     const auto b2b_begin = Clock::now();

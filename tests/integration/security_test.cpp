@@ -108,6 +108,15 @@ class Security : public ParticipantsTest {
     return localizer_count(d, kNanOdometry, 0);  // once the samples written in the meantime are counted too
   }
 
+  // A participant process that must not start: it exits non-zero, its log saying `why`.
+  void expect_refused(const std::vector<std::string>& argv, const std::string& why) {
+    ChildProcess p(argv, path("refused.log"));
+    const auto code = p.wait(scaled(30s));
+    ASSERT_TRUE(code) << "it did not stop";
+    EXPECT_NE(*code, 0);
+    EXPECT_NE(p.log().find(why), std::string::npos) << p.log();
+  }
+
   std::string keystore_;
   dds::DdsOptions secured_;
   std::unique_ptr<ChildProcess> gateway_, decoder_, localizer_;
@@ -238,23 +247,14 @@ TEST_F(Security, ARevokedIdentityIsShutOut) {
   write_nan_odometry(odometry, "robot2", 20);
   EXPECT_EQ(localizer_count(diagnostics, kNanOdometry, 0), 0u);
   // Started with the new keystore, it does not start at all, and says why.
-  ChildProcess gateway(command("gateway", {"--keystore", keystore_, "--robot", "robot2"}),
-                       path("revoked.log"));
-  const auto code = gateway.wait(scaled(30s));
-  ASSERT_TRUE(code);
-  EXPECT_NE(*code, 0);
-  EXPECT_NE(gateway.log().find("certificate revoked"), std::string::npos) << gateway.log();
+  expect_refused(command("gateway", {"--keystore", keystore_, "--robot", "robot2"}), "certificate revoked");
 }
 
 TEST_F(Security, AnExpiredIdentityDoesNotStartAndSaysWhy) {
   deployment_keys("enclave " + keystore_ + " decoder --enclave /expired --not-before 20200101000000Z " +
                   "--not-after 20200201000000Z");
-  ChildProcess decoder(command("decoder", {"--keystore", keystore_, "--enclave", "/expired"}),
-                       path("expired.log"));
-  const auto code = decoder.wait(scaled(30s));
-  ASSERT_TRUE(code);
-  EXPECT_NE(*code, 0);
-  EXPECT_NE(decoder.log().find("expired on Feb  1 00:00:00 2020 GMT"), std::string::npos) << decoder.log();
+  expect_refused(command("decoder", {"--keystore", keystore_, "--enclave", "/expired"}),
+                 "expired on Feb  1 00:00:00 2020 GMT");
 }
 
 // robot2's gateway identity whose messages are altered on the wire once it is matched: the
