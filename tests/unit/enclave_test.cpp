@@ -43,8 +43,9 @@ class EnclaveTest : public ::testing::Test {
 std::string EnclaveTest::dir_, EnclaveTest::keystore_;
 
 TEST_F(EnclaveTest, EveryRoleOfADeploymentIsAccepted) {
-  for (const char* enclave : {"/beaconloc/gateway/robot1", "/beaconloc/bridge/robot1", "/beaconloc/decoder",
-                              "/beaconloc/localizer", "/beaconloc/monitor", "/beaconloc_viewer", "/beaconloc_robot"}) {
+  for (const char* enclave :
+       {"/beaconloc/gateway/robot1", "/beaconloc/bridge/robot1", "/beaconloc/decoder", "/beaconloc/localizer",
+        "/beaconloc/monitor", "/beaconloc_viewer", "/beaconloc_robot"}) {
     EXPECT_EQ(refusal(keystore_, enclave), "") << enclave;
   }
   const dds::EnclaveFiles files = dds::check_enclave({keystore_, ""}, "/beaconloc/decoder", now());
@@ -112,16 +113,18 @@ TEST_F(EnclaveTest, PermissionsNotSignedByTheCaOrNotForThisIdentityOrExpiredAreR
   fs::copy(fs::path(keystore_) / "enclaves/beaconloc/decoder", foreign);
   fs::copy_file(fs::path(other) / "enclaves/beaconloc/decoder/permissions.p7s", foreign / "permissions.p7s",
                 fs::copy_options::overwrite_existing);
-  EXPECT_NE(refusal(keystore_, "/foreign_permissions").find("is not signed by the permissions CA"), std::string::npos)
+  EXPECT_NE(refusal(keystore_, "/foreign_permissions").find("is not signed by the permissions CA"),
+            std::string::npos)
       << refusal(keystore_, "/foreign_permissions");
   // The localizer's permissions beside the decoder's identity.
   const fs::path borrowed = fs::path(keystore_) / "enclaves/borrowed";
   fs::copy(fs::path(keystore_) / "enclaves/beaconloc/decoder", borrowed);
-  fs::copy_file(fs::path(keystore_) / "enclaves/beaconloc/localizer/permissions.p7s", borrowed / "permissions.p7s",
-                fs::copy_options::overwrite_existing);
-  EXPECT_NE(refusal(keystore_, "/borrowed")
-                .find("grant nothing to this identity (CN=/beaconloc/decoder); they name CN=/beaconloc/localizer"),
-            std::string::npos)
+  fs::copy_file(fs::path(keystore_) / "enclaves/beaconloc/localizer/permissions.p7s",
+                borrowed / "permissions.p7s", fs::copy_options::overwrite_existing);
+  EXPECT_NE(
+      refusal(keystore_, "/borrowed")
+          .find("grant nothing to this identity (CN=/beaconloc/decoder); they name CN=/beaconloc/localizer"),
+      std::string::npos)
       << refusal(keystore_, "/borrowed");
   // A grant that expired, beside a valid identity of the same name.
   deployment_keys("enclave " + keystore_ + " decoder --enclave /lapsed --not-before 20200101000000Z " +

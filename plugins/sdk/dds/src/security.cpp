@@ -3,8 +3,8 @@
 #include <openssl/bio.h>
 #include <openssl/err.h>
 #include <openssl/pem.h>
-#include <openssl/x509.h>
 #include <openssl/pkcs7.h>
+#include <openssl/x509.h>
 #include <openssl/x509_vfy.h>
 #include <tinyxml2.h>
 
@@ -107,7 +107,8 @@ std::string openssl_reason() {
 
 // The document an S/MIME file signed by the CA holds, verified as Fast DDS verifies it
 // (Permissions.cpp: PKCS7_verify with PKCS7_TEXT).
-std::string signed_document(const std::string& path, X509* ca, const std::string& ca_path, const std::string& what) {
+std::string signed_document(const std::string& path, X509* ca, const std::string& ca_path,
+                            const std::string& what) {
   auto in = open_pem(path);
   if (!in) throw SecurityError(what + " '" + path + "' cannot be read");
   BIO* content = nullptr;
@@ -160,8 +161,8 @@ void check_grant(const std::string& document, const std::string& path, const std
   const tinyxml2::XMLElement* dds = xml.FirstChildElement("dds");
   const tinyxml2::XMLElement* permissions = dds ? dds->FirstChildElement("permissions") : nullptr;
   std::string named;
-  for (const tinyxml2::XMLElement* grant = permissions ? permissions->FirstChildElement("grant") : nullptr; grant;
-       grant = grant->NextSiblingElement("grant")) {
+  for (const tinyxml2::XMLElement* grant = permissions ? permissions->FirstChildElement("grant") : nullptr;
+       grant; grant = grant->NextSiblingElement("grant")) {
     const tinyxml2::XMLElement* name = grant->FirstChildElement("subject_name");
     const std::string grant_subject = trimmed(name ? name->GetText() : nullptr);
     if (grant_subject != subject) {
@@ -188,8 +189,8 @@ void check_grant(const std::string& document, const std::string& path, const std
     }
     return;
   }
-  throw SecurityError("permissions '" + path + "' grant nothing to this identity (" + subject + "); they name " +
-                      (named.empty() ? std::string("no subject") : named));
+  throw SecurityError("permissions '" + path + "' grant nothing to this identity (" + subject +
+                      "); they name " + (named.empty() ? std::string("no subject") : named));
 }
 
 }  // namespace
@@ -287,7 +288,8 @@ EnclaveFiles check_enclave(const SecurityOptions& options, const std::string& en
                         files.certificate);
   }
   auto permissions_ca = read_certificate(files.permissions_ca, "enclave " + enclave + ": permissions CA");
-  signed_document(files.governance, permissions_ca.get(), files.permissions_ca, "enclave " + enclave + ": governance");
+  signed_document(files.governance, permissions_ca.get(), files.permissions_ca,
+                  "enclave " + enclave + ": governance");
   check_grant(signed_document(files.permissions, permissions_ca.get(), files.permissions_ca,
                               "enclave " + enclave + ": permissions"),
               files.permissions, subject_rfc2253(cert.get()), now_unix_s);
