@@ -21,7 +21,7 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
       on_truth_(std::move(on_truth)),
       throttle_(std::move(throttle)),
       participant_(dds, "beaconloc.gateway." + options_.robot_id),
-      map_writer_(participant_.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic)),
+      map_writer_(participant_.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, &map_readers_)),
       // The robot's measurements, in its partition (a gateway's permissions grant it no other).
       tof_writer_(participant_.robot_writer<msg::RawTofPubSubType>(dds::kRawTofTopic, options_.robot_id)),
       pulse_writer_(participant_.robot_writer<msg::PulseArrivalPubSubType>(dds::kPulseArrivalTopic, options_.robot_id)),
@@ -71,6 +71,7 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
     tof_writer_->assert_liveliness();
     pulse_writer_->assert_liveliness();
     odometry_writer_->assert_liveliness();
+    repeat_map_after_match();
   });
   if (!options_.firings_csv.empty()) {
     firings_.open(options_.firings_csv);
@@ -135,6 +136,23 @@ void GatewayParticipant::stop() {
 
 void GatewayParticipant::rethrow_failure() const {
   if (!failure_.empty()) throw std::runtime_error(failure_);
+}
+
+void GatewayParticipant::repeat_map_after_match() {
+  if (!map_written_.load(std::memory_order_acquire)) return;
+  const StampNs match_ns = map_readers_.newest_match_ns.load();
+  if (match_ns == 0) return;
+  if (match_ns != map_repeat_match_ns_) {
+    map_repeat_match_ns_ = match_ns;
+    map_repeats_ = 0;
+  }
+  // Once a second for kMapRepeats seconds after the newest match.
+  if (map_repeats_ == kMapRepeats ||
+      dds::steady_clock_ns() - match_ns < static_cast<StampNs>(map_repeats_ + 1) * kNsPerSecond) {
+    return;
+  }
+  ++map_repeats_;
+  if (!map_writer_->write(&map_msg_)) count(false);  // the same map: not a new sample
 }
 
 void GatewayParticipant::count(bool written) {
@@ -254,8 +272,9 @@ void GatewayParticipant::run() {
   // real times. A recording keeps its own clock.
   const StampNs offset_ns =
       source_->relative_stamps() && options_.wall_clock_stamps ? dds::wall_clock_ns() : 0;
-  auto beacon_map = dds::to_msg(source_->beacon_map(), options_.frame_id);
-  count(map_writer_->write(&beacon_map));
+  map_msg_ = dds::to_msg(source_->beacon_map(), options_.frame_id);
+  count(map_writer_->write(&map_msg_));
+  map_written_.store(true, std::memory_order_release);
   if (throttle_) throttle_();  // before the first sample: the map may be waited for
 
   std::vector<SourceEvent> events;

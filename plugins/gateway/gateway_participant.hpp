@@ -4,12 +4,15 @@
 // throttle lets it; writes the source's ground truth to a CSV when asked. A source that calls its
 // beacons (the simulator) fires by the FiringPlan a localizer sends for its robot while the plan
 // is fresh, and every beacon otherwise (seed 004 selective activation).
+#include <beaconloc.h>
+
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -20,6 +23,7 @@
 #include "beaconloc/dds/diagnostics_publisher.hpp"
 #include "beaconloc/dds/participant.hpp"
 #include "beaconloc/dds/periodic_task.hpp"
+#include "beaconloc/dds/wall_clock.hpp"
 #include "firing_scheduler.hpp"
 #include "source.hpp"
 
@@ -92,12 +96,30 @@ class GatewayParticipant {
   void log_firings(StampNs offset_ns);
   std::string firing_summary();
   void count(bool written);
+  // On the liveliness task: the map again each second for kMapRepeats s after the newest reader matched.
+  void repeat_map_after_match();
+  static constexpr std::size_t kMapRepeats = 10;
 
   GatewayOptions options_;
   std::unique_ptr<Source> source_;
   TruthCallback on_truth_;
   Throttle throttle_;
   dds::Participant participant_;
+  // The beacon map is written once (transient local), and again each second for kMapRepeats s after
+  // each reader that matched: a late-joining reader of a transient-local writer misses its samples
+  // now and then (eProsima/Fast-DDS#3822, open), and more often secured, where it drops what
+  // arrives before it holds the writer's keys: the decoder or the localizer stayed "waiting for
+  // the beacon map" in 4 of 24 secured starts on a loaded machine. Readers take an unchanged map as
+  // nothing new.
+  class MapReaders : public eprosima::fastdds::dds::DataWriterListener {
+   public:
+    void on_publication_matched(eprosima::fastdds::dds::DataWriter*,
+                                const eprosima::fastdds::dds::PublicationMatchedStatus& s) override {
+      if (s.current_count_change > 0) newest_match_ns = dds::steady_clock_ns();
+    }
+    std::atomic<StampNs> newest_match_ns{0};
+  };
+  MapReaders map_readers_;  // before the writer it listens to
   // Owned; what writes through them (the run thread, the liveliness and Diagnostics tasks) is
   // declared after them, so stops before they go.
   dds::Writer map_writer_;
@@ -118,6 +140,10 @@ class GatewayParticipant {
   std::uint64_t firings_planned_ = 0;  // the source's firings by a plan
   std::uint64_t firings_every_ = 0;    // and of every beacon in turn
   std::atomic<StampNs> now_stamp_ns_{-1};
+  msg::BeaconMap map_msg_;  // set by run() before map_written_, not changed after
+  std::atomic<bool> map_written_{false};
+  StampNs map_repeat_match_ns_ = 0;  // the liveliness task's: the match its repeats are for,
+  std::size_t map_repeats_ = 0;      // and how many it has written
   std::uint64_t odometry_sequence_ = 0;
   std::mutex counts_mutex_;
   RejectionCounter counts_;  // accepted = samples written; rejected = write failures

@@ -47,16 +47,39 @@ class Security : public ParticipantsTest {
   }
   // The secured pipeline: a simulated robot1 until stopped, the decoder and the localizer, each
   // with its role's default enclave; returns once the localizer has localized robot1 for 1 s.
+  // Started once more, said on stdout, when the first start fails with a participant that never
+  // got the beacon map: Fast DDS 2.9 sometimes leaves a secured writer-reader pair unable to
+  // deliver anything (docs/security.md, "Not done"; about 1 start in 20 on a loaded machine), which
+  // is not what these tests are about. Any other failure fails.
   void start_pipeline(const PoseRecorder& poses) {
     const std::vector<std::string> keys{"--keystore", keystore_};
-    gateway_ = std::make_unique<ChildProcess>(
-        command("gateway", {"--keystore", keystore_, "--robot", "robot1", "--duration-s", "0"}),
-        path("gateway.log"));
-    decoder_ = std::make_unique<ChildProcess>(command("decoder", keys), path("decoder.log"));
-    localizer_ = std::make_unique<ChildProcess>(command("localizer", keys), path("localizer.log"));
-    ASSERT_TRUE(wait_for_pose_span(poses, "robot1", 1s))
-        << "no secured pose of robot1\n"
-        << gateway_->log() << decoder_->log() << localizer_->log();
+    for (int attempt = 1;; ++attempt) {
+      gateway_ = std::make_unique<ChildProcess>(
+          command("gateway", {"--keystore", keystore_, "--robot", "robot1", "--duration-s", "0"}),
+          path("gateway.log"));
+      decoder_ = std::make_unique<ChildProcess>(command("decoder", keys), path("decoder.log"));
+      localizer_ = std::make_unique<ChildProcess>(command("localizer", keys), path("localizer.log"));
+      if (wait_for_pose_span(poses, "robot1", 1s)) return;
+      // What each participant says of itself, through a reader of this process.
+      DiagnosticsRecorder diagnostics(secured_);
+      std::this_thread::sleep_for(3s);
+      bool map_lost = false;
+      for (const auto& [name, report] : diagnostics.reports()) {
+        print_report(name, report, std::cout);
+        map_lost = map_lost || report.last.message().find("waiting for the beacon map") != std::string::npos;
+      }
+      if (attempt == 1 && map_lost) {
+        std::cout
+            << "a participant never got the beacon map (Fast DDS 2.9 secured matching): started again\n";
+        for (auto* p : {&gateway_, &decoder_, &localizer_}) {
+          ASSERT_NO_FATAL_FAILURE(stop_cleanly(**p, "participant"));
+          p->reset();
+        }
+        continue;
+      }
+      FAIL() << "no secured pose of robot1 (" << poses.count() << " poses)\n"
+             << gateway_->log() << decoder_->log() << localizer_->log();
+    }
   }
   void TearDown() override {
     for (auto* p : {&gateway_, &decoder_, &localizer_}) {
