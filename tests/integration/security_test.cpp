@@ -132,6 +132,17 @@ class Security : public ParticipantsTest {
     return localizer_count(d, kNanOdometry, 0);  // once the samples written in the meantime are counted too
   }
 
+  // An attacker whose own access control lets it write `robot`'s odometry (NaN): never matched,
+  // nothing of it counted by the localizer.
+  void expect_shut_out(const dds::DdsOptions& attacker_options, const std::string& robot,
+                       const DiagnosticsRecorder& diagnostics) {
+    dds::Participant attacker(attacker_options, "test.attacker");
+    auto odometry = attacker.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, robot);
+    EXPECT_FALSE(dds::wait_for_matched_readers({odometry}, scaled(5s)))
+        << "the attacker's writer was matched";
+    write_nan_odometry(odometry, robot, 20);
+    EXPECT_EQ(localizer_count(diagnostics, kNanOdometry, 0), 0u);
+  }
   // A participant process that must not start: it exits non-zero, its log saying `why`.
   void expect_refused(const std::vector<std::string>& argv, const std::string& why) {
     ChildProcess p(argv, path("refused.log"));
@@ -247,11 +258,7 @@ TEST_F(Security, PermissionsNotSignedByTheDeploymentAreRefused) {
   }
   dds::DdsOptions o = as("/beaconloc/monitor");
   o.security.keystore = forged;
-  dds::Participant attacker(o, "test.forged");
-  auto odometry = attacker.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, "robot1");
-  EXPECT_FALSE(dds::wait_for_matched_readers({odometry}, scaled(5s))) << "forged permissions were honoured";
-  write_nan_odometry(odometry, "robot1", 20);
-  EXPECT_EQ(localizer_count(diagnostics, kNanOdometry, 0), 0u);
+  expect_shut_out(o, "robot1", diagnostics);
 }
 
 // Revoked by the CRL the deployment re-issued: a participant still holding the keystore from
@@ -276,11 +283,7 @@ TEST_F(Security, ARevokedIdentityIsShutOut) {
   ASSERT_NO_FATAL_FAILURE(start_pipeline(poses));  // with the new keystore
   dds::DdsOptions o = as("/beaconloc/gateway/robot2");
   o.security.keystore = before;
-  dds::Participant revoked(o, "test.revoked");
-  auto odometry = revoked.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, "robot2");
-  EXPECT_FALSE(dds::wait_for_matched_readers({odometry}, scaled(5s))) << "a revoked identity was matched";
-  write_nan_odometry(odometry, "robot2", 20);
-  EXPECT_EQ(localizer_count(diagnostics, kNanOdometry, 0), 0u);
+  expect_shut_out(o, "robot2", diagnostics);
   // Started with the new keystore, it does not start at all, and says why.
   expect_refused(command("gateway", {"--keystore", keystore_, "--robot", "robot2"}), "certificate revoked");
 }
