@@ -1,0 +1,1 @@
+# Included from plugins/CMakeLists.txt: paths are relative to plugins/.
