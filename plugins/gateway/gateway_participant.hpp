@@ -25,6 +25,7 @@
 #include "beaconloc/dds/periodic_task.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
 #include "firing_scheduler.hpp"
+#include "replay/bus_recording.hpp"
 #include "source.hpp"
 
 namespace beaconloc {
@@ -40,8 +41,9 @@ struct GatewayOptions {
   static constexpr double kMaxSpeed = 1e4;
   std::uint64_t seed = 1;
   std::string truth_csv;  // ground truth written here when not empty
-  // The samples written, as CSV (tof.csv, odometry.csv, with the simulator's hidden truth: who
-  // fired, echo or not), when not empty.
+  // The samples written, when not empty: a recording of the bus (replay/bus_recording.hpp: tof.csv
+  // or pulse.csv, odometry.csv, scan.csv, receivers.csv), with the simulator's hidden truth (who
+  // fired, echo or not); `beaconloc run --replay` replays it.
   std::string record_dir;
   std::string frame_id = "map";
   // Every firing of the source (fire_stamp_ns,beacon_id,planned,heard), as CSV, when not empty:
@@ -50,6 +52,14 @@ struct GatewayOptions {
   // Simulated stamps start at 0; live, they are offset to the wall clock at start. A replayed
   // recording keeps its own clock either way. false: byte-identical runs (run).
   bool wall_clock_stamps = true;
+  // Before the first sample, wait (until stopped) for this many matched readers on each
+  // measurement topic (TOFs or pulse arrivals, and odometry) besides the run's own: a recorder or a
+  // second localizer hears the run from its start. 0: no wait.
+  int wait_for_readers = 0;
+  // The run's own readers of each (`run` sets them: its decoder or localizer, its localizer and bridge).
+  int own_beacon_readers = 0;
+  int own_odometry_readers = 0;
+  static constexpr int kMaxWaitForReaders = 1000;
 };
 
 // What the gateway has written so far (read by a throttle in the same process).
@@ -89,6 +99,8 @@ class GatewayParticipant {
 
  private:
   void run();
+  // options_.wait_for_readers on each measurement writer; false when stopped first.
+  bool wait_for_readers_before_start();
   void publish(SourceEvent& e, StampNs offset_ns);
   // The source fires by the newest fresh firing plan, or every beacon (FiringScheduler); the
   // firings go to the firing log.
@@ -128,9 +140,7 @@ class GatewayParticipant {
   dds::Writer odometry_writer_;
   dds::Writer scan_writer_;
   std::ofstream truth_;
-  std::ofstream record_tof_;
-  std::ofstream record_pulse_;
-  std::ofstream record_odometry_;
+  std::optional<BusRecordingWriter> record_;  // the samples as published, when options_.record_dir is set
   std::ofstream firings_;
   // Selective activation: the plans for this robot (a source that honours them), judged by the
   // gateway's stamps; -1 until the run has started.

@@ -4,14 +4,15 @@ beaconloc's rosbag2 writer. It shares no code with the writer: the Python standa
 yaml (python3-yaml) only, the format as rosbag2 defines it.
 
     check_rosbag2.py BAG_DIR [--after-kill] [--min-messages N]
-                     [--expect-poses CSV] [--expect-odometry CSV]
+                     [--expect-poses CSV] [--expect-odometry CSV] [--twists-from-wheels CSV]
 
 Checks metadata.yaml (structure; counts and times equal the database's, or with --after-kill
 never above them), the database (integrity, schema, topics, every message's topic and CDR
 encapsulation header) and decodes every geometry_msgs/msg/PoseWithCovarianceStamped and
 nav_msgs/msg/Odometry message in full (CDR little endian): the whole blob consumed, every float
 finite, covariances symmetric. With --expect-* CSVs, every message equals its row exactly
-(matched by header stamp; floats compared bit for bit).
+(matched by header stamp, a stamp's messages in order; floats compared bit for bit; an empty cell
+is not checked).
 
 Message timestamps need not grow with the row id: a recorder receives topics on several threads,
 and rosbag2 reads in (timestamp, id) order.
@@ -424,6 +425,8 @@ def float_bits(value):
 
 
 def load_expected(path, string_fields, float_fields):
+    """Rows by header stamp, in file order: a stamp may come twice (a pose corrected at its stamp
+    is published again). An empty float cell is not checked."""
     rows = {}
     with open(path, newline="", encoding="utf-8") as f:
         reader = csv.DictReader(f)
@@ -432,34 +435,35 @@ def load_expected(path, string_fields, float_fields):
             raise CheckFailed("%s: missing columns %s" % (path, missing))
         for line in reader:
             stamp = int(line["stamp_ns"])
-            if stamp in rows:
-                raise CheckFailed("%s: stamp %d twice" % (path, stamp))
             row = {"stamp_ns": stamp}
             row.update({k: line[k] for k in string_fields})
-            row.update({k: float(line[k]) for k in float_fields})
-            rows[stamp] = row
+            row.update({k: (float(line[k]) if line[k] != "" else None) for k in float_fields})
+            rows.setdefault(stamp, []).append(row)
     return rows
 
 
 def compare_expected(path, expected, decoded, type_name, string_fields, float_fields, problems):
+    """Each stamp's messages, in the bag's order, against that stamp's rows, in the file's order."""
     mismatches = []
     by_stamp = {}
     for m in decoded:
-        if m["stamp_ns"] in by_stamp:
-            mismatches.append("header stamp %d in two %s messages" % (m["stamp_ns"], type_name))
-        by_stamp[m["stamp_ns"]] = m
+        by_stamp.setdefault(m["stamp_ns"], []).append(m)
     for stamp in sorted(set(expected) - set(by_stamp)):
         mismatches.append("stamp %d expected, not in the bag" % stamp)
     for stamp in sorted(set(by_stamp) - set(expected)):
         mismatches.append("stamp %d in the bag, not expected" % stamp)
     for stamp in sorted(set(expected) & set(by_stamp)):
-        want, got = expected[stamp], by_stamp[stamp]
-        for k in string_fields:
-            if want[k] != got[k]:
-                mismatches.append("stamp %d: %s expected %r, got %r" % (stamp, k, want[k], got[k]))
-        for k in float_fields:
-            if float_bits(want[k]) != float_bits(got[k]):
-                mismatches.append("stamp %d: %s expected %r, got %r" % (stamp, k, want[k], got[k]))
+        wants, gots = expected[stamp], by_stamp[stamp]
+        if len(wants) != len(gots):
+            mismatches.append("stamp %d: %d %s messages, %d expected" % (stamp, len(gots), type_name, len(wants)))
+            continue
+        for want, got in zip(wants, gots):
+            for k in string_fields:
+                if want[k] != got[k]:
+                    mismatches.append("stamp %d: %s expected %r, got %r" % (stamp, k, want[k], got[k]))
+            for k in float_fields:
+                if want[k] is not None and float_bits(want[k]) != float_bits(got[k]):
+                    mismatches.append("stamp %d: %s expected %r, got %r" % (stamp, k, want[k], got[k]))
     for text in mismatches[:MAX_REPORTED]:
         problems.add("%s: %s" % (path, text))
     if len(mismatches) > MAX_REPORTED:
@@ -496,7 +500,27 @@ def check(args):
         compare_expected(args.expect_odometry, load_expected(args.expect_odometry, strings, odometry_floats),
                          decoded_of_type(topics, by_topic, ODOMETRY_TYPE), ODOMETRY_TYPE, strings,
                          odometry_floats, problems)
+    if args.twists_from_wheels:
+        check_twists(args.twists_from_wheels, decoded_of_type(topics, by_topic, ODOMETRY_TYPE), problems)
     return problems, topics, by_topic
+
+
+def check_twists(path, decoded, problems):
+    """Each Odometry message's twist is one the robot's wheels reported: (v, omega) =
+    ((right + left) / 2, (right - left) / wheel_base) of a row of a recording's odometry.csv, the
+    other components 0 (a planar robot). Which row depends on when the pose met the odometry."""
+    reported = set()
+    with open(path, newline="", encoding="utf-8") as f:
+        for line in csv.DictReader(f):
+            right, left = float(line["wheel_velocity_right_mps"]), float(line["wheel_velocity_left_mps"])
+            base = float(line["wheel_base_m"])
+            reported.add((float_bits((right + left) / 2.0), float_bits((right - left) / base)))
+    bad = [m for m in decoded
+           if (float_bits(m["vx"]), float_bits(m["wz"])) not in reported or
+           any(m[k] != 0.0 for k in ("vy", "vz", "wx", "wy"))]
+    for m in bad[:MAX_REPORTED]:
+        problems.add("%s: odometry at stamp %d has twist (%r, %r, %r; %r, %r, %r), no wheel row reported it"
+                     % (path, m["stamp_ns"], m["vx"], m["vy"], m["vz"], m["wx"], m["wy"], m["wz"]))
 
 
 def main(argv):
@@ -508,6 +532,8 @@ def main(argv):
     parser.add_argument("--expect-poses", help="CSV: stamp_ns,frame_id,x,y,z,qx,qy,qz,qw,cov0..cov35")
     parser.add_argument("--expect-odometry", help="CSV: stamp_ns,frame_id,child_frame_id,x..qw,vx..wz,"
                         "pose_cov0..35,twist_cov0..35")
+    parser.add_argument("--twists-from-wheels", help="a recording's odometry.csv: every Odometry twist is one of its"
+                        " rows' (v, omega)")
     args = parser.parse_args(argv)
     try:
         problems, topics, by_topic = check(args)

@@ -35,6 +35,7 @@
 #include "beaconloc/core/deadline_watch.hpp"
 #include "beaconloc/core/participant_id.hpp"
 #include "beaconloc/dds/checked_type.hpp"
+#include "beaconloc/dds/raw_cdr_type.hpp"
 #include "beaconloc/dds/periodic_task.hpp"
 #include "beaconloc/dds/security.hpp"
 #include "beaconloc/dds/topics.hpp"
@@ -358,6 +359,17 @@ class Participant {
     return make_reader(spec, topic(spec.name, new CheckedType<PubSubType>(&undecodable_)),
                        std::make_unique<SampleListener<Msg>>(std::move(on_sample), std::move(events),
                                                              spec.deadline_ns),
+                       nullptr);
+  }
+  // Each sample read and as the bytes it travelled in (raw_cdr_type.hpp): a recorder's reader of a
+  // topic that is not per robot (the ROS 2 ones).
+  template <class PubSubType>
+  [[nodiscard]] Reader subscribe_raw(const TopicSpec& spec,
+                                     typename SampleListener<RawSample<PubSubType>>::OnSample on_sample) {
+    if (spec.per_robot) throw std::logic_error(std::string("per-robot topic ") + spec.name + " needs subscribe");
+    return make_reader(spec, topic(spec.name, new RawCdrType<PubSubType>(&undecodable_)),
+                       std::make_unique<SampleListener<RawSample<PubSubType>>>(
+                           std::move(on_sample), ReaderEvents<RawSample<PubSubType>>{}, spec.deadline_ns),
                        nullptr);
   }
   // A reader with a listener of the caller's, which must outlive the handle (declared before it).
