@@ -16,6 +16,7 @@ std::vector<std::unique_ptr<Command>> add_commands(CLI::App& app) {
   add_offline_commands(app, commands);
   add_monitor_command(app, commands);
   add_record_command(app, commands);
+  add_serial_sim_command(app, commands);
   return commands;
 }
 

@@ -10,3 +10,7 @@ add_library(beaconloc_serial STATIC
   gateway/serial/serial_port.cpp)
 target_include_directories(beaconloc_serial PUBLIC gateway/serial)
 target_link_libraries(beaconloc_serial PUBLIC beaconloc_core PRIVATE beaconloc_warnings)
+
+# The gateway's source on a serial line (frames -> the bus's samples), on top of the above.
+add_library(beaconloc_serial_source STATIC gateway/serial/serial_source.cpp gateway/serial/line_simulator.cpp)
+target_link_libraries(beaconloc_serial_source PUBLIC beaconloc_serial beaconloc_sim PRIVATE beaconloc_warnings)

@@ -8,6 +8,7 @@ add_executable(beaconloc_serial_tests
   unit/serial/marvelmind_test.cpp
   unit/serial/parser_fuzz_test.cpp
   unit/serial/device_clock_test.cpp
-  unit/serial/serial_port_test.cpp)
-target_link_libraries(beaconloc_serial_tests PRIVATE beaconloc_serial GTest::gtest_main util beaconloc_warnings)
+  unit/serial/serial_port_test.cpp
+  unit/serial/serial_source_test.cpp)
+target_link_libraries(beaconloc_serial_tests PRIVATE beaconloc_serial beaconloc_serial_source GTest::gtest_main util beaconloc_warnings)
 gtest_discover_tests(beaconloc_serial_tests TEST_PREFIX "unit." DISCOVERY_TIMEOUT 30)
