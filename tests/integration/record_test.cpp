@@ -22,7 +22,7 @@ using namespace std::chrono_literals;
 const std::string kTools = std::string(BEACONLOC_SOURCE_DIR) + "/tests/tools/";
 // The built-in scenario's receivers, exactly as its simulator computes them.
 const std::string kReceivers =
-    "0.19:0,-0.09499999999999996:0.16454482671904336,-0.09499999999999996:-0.16454482671904336";
+    "0.19:0,-0.09499999999999996:0.16454482671904336,-0.09500000000000008:-0.1645448267190433";
 // The built-in scenario's settings a replay is not told by the recording (its decoder's limits and
 // noise, the robot's start): given as a user replaying it would.
 const std::vector<std::string> kReplaySettings{

@@ -24,7 +24,7 @@ using namespace std::chrono_literals;
 // circle (their coordinates as the simulator computes them), starting at (0.5, 0, 0); the gateway
 // and localizer are told as on a real robot.
 const std::string kReceivers =
-    "0.19:0,-0.09499999999999996:0.16454482671904336,-0.09499999999999996:-0.16454482671904336";
+    "0.19:0,-0.09499999999999996:0.16454482671904336,-0.09500000000000008:-0.1645448267190433";
 
 class SerialLine : public ParticipantsTest {
  protected:
@@ -38,7 +38,7 @@ class SerialLine : public ParticipantsTest {
   // socat's pair of pseudo-terminals, linked as gw (the gateway's end) and sim (the module's).
   void open_line() {
     line_ =
-        std::make_unique<ChildProcess>(std::vector<std::string>{"socat", "pty,raw,echo=0,link=" + path("gw"),
+        std::make_unique<ChildProcess>(std::vector<std::string>{BEACONLOC_SOCAT, "pty,raw,echo=0,link=" + path("gw"),
                                                                 "pty,raw,echo=0,link=" + path("sim")},
                                        path("socat.log"));
     ASSERT_TRUE(eventually(

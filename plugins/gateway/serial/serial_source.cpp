@@ -73,8 +73,9 @@ std::string SerialSource::describe() const {
 void SerialSource::read_loop() {
   std::array<std::uint8_t, 512> buffer{};
   std::vector<serial::Frame> frames;
+  // A stall is a line that spoke and stopped: silence before a device's first byte is not one.
   StampNs last_byte_ns = now_();
-  bool stalled = false;
+  bool spoken = false, stalled = false;
   while (!stop_) {
     if (!port_.is_open()) {
       std::this_thread::sleep_for(kReopenPeriod);
@@ -83,8 +84,7 @@ void SerialSource::read_loop() {
       if (!opened.ok()) continue;
       std::lock_guard<std::mutex> lock(mutex_);
       counts_.reject("serial.reopened");  // counted as the line's event, not a sample refused
-      last_byte_ns = now_();
-      stalled = false;
+      spoken = stalled = false;
     }
     const serial::SerialPort::IoResult r =
         port_.read(buffer.data(), buffer.size(), std::chrono::milliseconds(50));
@@ -98,13 +98,14 @@ void SerialSource::read_loop() {
       continue;
     }
     if (r.status != serial::SerialPort::Status::kData) {
-      if (!stalled && arrival_ns - last_byte_ns > kStalledNs) {
+      if (spoken && !stalled && arrival_ns - last_byte_ns > kStalledNs) {
         counts_.reject("serial.stalled");
         stalled = true;
       }
       continue;
     }
     last_byte_ns = arrival_ns;
+    spoken = true;
     stalled = false;
     frames.clear();
     parser_.push(buffer.data(), r.size, arrival_ns, frames);

@@ -43,8 +43,8 @@ class SerialSource final : public Source {
  public:
   // A device that goes away is reopened this often while it is missing.
   static constexpr std::chrono::milliseconds kReopenPeriod{250};
-  // No byte for this long is a stalled line, counted once per stall: a receiver sends a heartbeat
-  // at least every 100 ms (docs/serial-protocol.md), so three are missing.
+  // No byte for this long, after the line spoke, is a stalled line, counted once per stall: a
+  // receiver sends a heartbeat at least every 100 ms (docs/serial-protocol.md), so three are missing.
   static constexpr StampNs kStalledNs = 300 * kNsPerMillisecond;
 
   using Clock = std::function<StampNs()>;  // the host's time, ns since the epoch
