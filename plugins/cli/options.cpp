@@ -63,8 +63,8 @@ OptionSet gateway_option_set(GatewayOptions& o, std::optional<std::uint64_t>& se
       .text("--firings-out", o.firings_csv,
             "write every beacon firing as CSV here (fire_stamp_ns,beacon_id,planned,heard)")
       .whole("--wait-for-readers", o.wait_for_readers,
-             "before the first sample, wait for this many readers besides the run's own on the TOF (or pulse) and "
-             "odometry topics: a recorder, a second localizer",
+             "before the first sample, wait for this many readers besides the run's own (for gateway: in all) on the "
+             "TOF (or pulse) and odometry topics: a recorder, a second localizer",
              whole_in(0, GatewayOptions::kMaxWaitForReaders));
   return set;
 }

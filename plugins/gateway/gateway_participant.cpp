@@ -172,6 +172,18 @@ void GatewayParticipant::count(bool written) {
   }
 }
 
+template <class Write>
+void GatewayParticipant::record(Write&& write) {
+  if (!record_) return;
+  try {
+    write();
+  } catch (const std::runtime_error& e) {
+    // A full disk, say: the run goes on without its recording, and fails at the end saying why.
+    failure_ = e.what();
+    record_.reset();
+  }
+}
+
 void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
   const StampNs stamp = e.stamp_ns + offset_ns;
   if (e.has_truth) {
@@ -185,7 +197,7 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
   switch (e.kind) {
     case SourceEvent::Kind::kTof: {
       e.tof.fire_stamp_ns += offset_ns;
-      if (record_) record_->write(e.tof, {e.true_beacon_id, e.tof_is_echo});
+      record([&] { record_->write(e.tof, {e.true_beacon_id, e.tof_is_echo}); });
       auto m = dds::to_msg(options_.robot_id, e.tof);
       count(tof_writer_->write(&m));  // bool in Fast DDS 2.9 (TOOLCHAIN.md)
       ++progress_.tofs_written;
@@ -193,7 +205,7 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
     }
     case SourceEvent::Kind::kPulse: {
       e.pulse.stamp_ns = stamp;
-      if (record_) record_->write(e.pulse, {e.true_beacon_id, e.tof_is_echo});
+      record([&] { record_->write(e.pulse, {e.true_beacon_id, e.tof_is_echo}); });
       auto m = dds::to_msg(options_.robot_id, e.pulse);
       count(pulse_writer_->write(&m));
       ++progress_.tofs_written;
@@ -201,7 +213,7 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
     }
     case SourceEvent::Kind::kOdometry: {
       e.odometry.stamp_ns = stamp;
-      if (record_) record_->write(e.odometry);
+      record([&] { record_->write(e.odometry); });
       auto m = dds::to_msg(options_.robot_id, e.odometry, odometry_sequence_++);
       count(odometry_writer_->write(&m));
       ++progress_.odometry_written;
@@ -209,7 +221,7 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
     }
     case SourceEvent::Kind::kLaserScan: {
       e.scan.stamp_ns = stamp;
-      if (record_) record_->write(e.scan);
+      record([&] { record_->write(e.scan); });
       auto m = dds::to_msg(options_.robot_id, e.scan);
       count(scan_writer_->write(&m));
       break;

@@ -102,6 +102,10 @@ class GatewayParticipant {
   // options_.wait_for_readers on each measurement writer; false when stopped first.
   bool wait_for_readers_before_start();
   void publish(SourceEvent& e, StampNs offset_ns);
+  // The run thread's write to the recording (record_), if any; a failure ends the recording and
+  // is the run's failure.
+  template <class Write>
+  void record(Write&& write);
   // The source fires by the newest fresh firing plan, or every beacon (FiringScheduler); the
   // firings go to the firing log.
   void apply_firing_plan(StampNs now_stamp_ns);

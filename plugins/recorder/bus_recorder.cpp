@@ -33,9 +33,9 @@ bool same_beacons(const BeaconMap& a, const BeaconMap& b) {
 
 BusRecorder::BusRecorder(const dds::DdsOptions& dds, BusRecorderOptions options)
     : options_(std::move(options)),
+      participant_(dds, "beaconloc.recorder." + options_.robot_id),
       writer_(options_.out_dir, false),
-      estimates_(options_.out_dir + "/estimate.csv", estimates_csv_header()),
-      participant_(dds, "beaconloc.recorder." + options_.robot_id) {
+      estimates_(options_.out_dir + "/estimate.csv", estimates_csv_header()) {
   if (options_.receivers) writer_.write_receivers(*options_.receivers);
   const std::string& robot = options_.robot_id;
   tof_reader_ =

@@ -41,6 +41,7 @@ class BusRecorder {
   void on_beacon_map(const BeaconMap& map);
 
   BusRecorderOptions options_;
+  dds::Participant participant_;  // first: a participant that cannot start leaves no file behind
   mutable std::mutex mutex_;
   BusRecordingWriter writer_;
   LineFile estimates_;
@@ -48,7 +49,6 @@ class BusRecorder {
   std::map<std::string, std::uint64_t> written_;
   std::map<std::string, std::uint64_t> refused_;
   std::atomic<std::uint64_t> samples_{0};
-  dds::Participant participant_;
   dds::Reader tof_reader_, pulse_reader_, odometry_reader_, scan_reader_, map_reader_, pose_reader_;  // last
 };
 

@@ -8,8 +8,8 @@ namespace beaconloc {
 
 Ros2BagRecorder::Ros2BagRecorder(const dds::DdsOptions& dds, Ros2BagOptions options)
     : options_(std::move(options)),
-      bag_(options_.bag_dir, bridge::kRos2Distro),
-      participant_(dds, "beaconloc.ros2_recorder") {
+      participant_(dds, "beaconloc.ros2_recorder"),
+      bag_(options_.bag_dir, bridge::kRos2Distro) {
   // What each topic's writers offer (examples/qos/ros2_topics.xml), so that `ros2 bag play`
   // offers it again: the bridge's outputs as the bridge writes them; a robot driver's odom and
   // scan as sensor data (best effort), rviz2's initialpose reliable.

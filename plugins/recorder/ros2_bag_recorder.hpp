@@ -42,12 +42,12 @@ class Ros2BagRecorder {
            rosbag2::TopicQos offered);
 
   Ros2BagOptions options_;
+  dds::Participant participant_;  // first: a participant that cannot start leaves no bag behind
   mutable std::mutex mutex_;
   rosbag2::Rosbag2Writer bag_;
   bool closed_ = false;
   std::map<std::string, std::uint64_t> written_;
   std::uint64_t failed_writes_ = 0;
-  dds::Participant participant_;
   std::vector<dds::Reader> readers_;  // last: stop before what they use goes
 };
 

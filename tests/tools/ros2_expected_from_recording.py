@@ -6,7 +6,7 @@ rotation about z), not from the bridge's code: for each row of a `beaconloc reco
 geometry_msgs/PoseWithCovarianceStamped and of its nav_msgs/Odometry, as CSVs for
 check_rosbag2.py --expect-poses / --expect-odometry. The odometry's twist is left unchecked (empty
 cells): it is the wheels' newest report when the pose arrived (check_rosbag2.py
---twists-from-wheels checks it).
+--twists-from-wheels checks it); its covariance is expected all zeros (the bridge states none).
 
     ros2_expected_from_recording.py ESTIMATE_CSV POSES_OUT ODOMETRY_OUT [--map-frame map] [--base-frame base_link]
 """
@@ -51,8 +51,9 @@ def main(argv):
             cov = covariance36(row)
             stamp = int(row["stamp_ns"])
             poses.writerow([stamp, args.map_frame] + [repr(v) for v in pose + cov])
+            # The twist's covariance: none is given (all zeros) until the bridge states one.
             odometry.writerow([stamp, args.map_frame, args.base_frame] + [repr(v) for v in pose] + [""] * 6 +
-                              [repr(v) for v in cov] + [""] * 36)
+                              [repr(v) for v in cov] + [repr(0.0)] * 36)
             rows += 1
     if rows == 0:
         print("ros2_expected_from_recording: no pose in %s" % args.estimate_csv, file=sys.stderr)

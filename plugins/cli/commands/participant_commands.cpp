@@ -46,8 +46,6 @@ class GatewayCommand : public Command {
     app_->add_option("--beacons", beacons_file_, "the site's beacons CSV (beacon_id,x_m,y_m,z_m): needed with --serial")
         ->check(CLI::ExistingFile)
         ->needs(serial_device);
-    app_->add_option("--receivers", receivers_.receivers, "the robot's receivers, x:y[,x:y...] (m)")
-        ->needs(serial_device);
     app_->add_option("--temperature-c", serial_.temperature_c,
                      "air temperature for TOFs that carry none (and Marvelmind distances' reference)")
         ->transform(real_in(-100.0, 100.0))
@@ -66,7 +64,6 @@ class GatewayCommand : public Command {
       }
       serial_.protocol = serial_protocol_ == "marvelmind" ? serial::Protocol::kMarvelmind : serial::Protocol::kBeaconloc;
       serial_.beacons = load_beacon_map_csv(beacons_file_);
-      if (!receivers_.receivers.empty()) serial_.receivers = receivers_.config().receivers;
       gateway_.speed = 1.0;
       source = std::make_unique<SerialSource>(serial_, [] { return dds::wall_clock_ns(); });
     } else {
@@ -92,7 +89,6 @@ class GatewayCommand : public Command {
   SerialSourceOptions serial_;
   std::string serial_protocol_ = "beaconloc";
   std::string beacons_file_;
-  LocalizerSettings receivers_;  // its receivers only
 };
 
 class DecoderCommand : public Command {

@@ -46,7 +46,7 @@ class RecordCommand : public Command {
                                   "' is not empty: a recording is never written over another");
     }
     bus_.out_dir = out_dir_;
-    if (!receivers_.receivers.empty()) bus_.receivers = receivers_.config().receivers;
+    bus_.receivers = receivers_.config().receivers;
     bag_.bag_dir = out_dir_ + "/rosbag2";
     BusRecorder bus(dds_, bus_);
     std::unique_ptr<Ros2BagRecorder> bag;

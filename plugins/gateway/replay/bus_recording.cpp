@@ -87,6 +87,13 @@ BusRecordingWriter::BusRecordingWriter(std::string directory, bool with_hidden_t
   std::error_code ec;
   std::filesystem::create_directories(directory_, ec);
   if (ec) throw std::runtime_error("cannot create '" + directory_ + "': " + ec.message());
+  // Files are made with their first sample: an earlier recording's in the same directory (a
+  // scan.csv this run will not write) must not be replayed with this one.
+  for (const char* file : {bus_recording::kTofFile, bus_recording::kPulseFile, bus_recording::kOdometryFile,
+                           bus_recording::kScanFile, bus_recording::kReceiversFile, bus_recording::kBeaconsFile}) {
+    std::filesystem::remove(path(file), ec);
+    if (ec) throw std::runtime_error("cannot remove the earlier '" + path(file) + "': " + ec.message());
+  }
 }
 
 void BusRecordingWriter::write(const RawTofSample& t, const HiddenTruth& truth) {
@@ -164,18 +171,18 @@ void BusRecordingWriter::write_beacons(const BeaconMap& map) const {
 }
 
 void BusRecordingWriter::write_receivers(const ReceiverArray& receivers) const {
-  LineFile file(path(bus_recording::kReceiversFile), bus_recording::kReceiversHeader);
+  std::string text = std::string(bus_recording::kReceiversHeader) + '\n';
   for (std::size_t i = 0; i < receivers.size(); ++i) {
-    std::string line;
-    append_unsigned(line, i);
-    line += ',';
-    append_decimal(line, receivers.receivers_base_m[i].x());
-    line += ',';
-    append_decimal(line, receivers.receivers_base_m[i].y());
-    line += ',';
-    append_decimal(line, receivers.receiver_height_m);
-    file.write_line(std::move(line));
+    append_unsigned(text, i);
+    text += ',';
+    append_decimal(text, receivers.receivers_base_m[i].x());
+    text += ',';
+    append_decimal(text, receivers.receivers_base_m[i].y());
+    text += ',';
+    append_decimal(text, receivers.receiver_height_m);
+    text += '\n';
   }
+  write_file_atomically(path(bus_recording::kReceiversFile), text);
 }
 
 }  // namespace beaconloc

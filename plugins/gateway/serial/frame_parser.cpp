@@ -159,6 +159,12 @@ void FrameParser::scan(StampNs arrival_ns, std::vector<Frame>& out) {
 void FrameParser::accept_beaconloc(const std::uint8_t* frame, StampNs arrival_ns, std::vector<Frame>& out) {
   // The checksum vouches for the sequence number, refused frame or not: it was sent, not lost.
   const std::uint8_t sequence = frame[4];
+  if (have_sequence_ && sequence == last_sequence_) {
+    // The frame before it again (a module resending): taken once. (256 frames lost in a row would
+    // read the same; the line's silence for them is told as a stall.)
+    ++counts_.rejected[static_cast<std::size_t>(FrameRejection::kDuplicate)];
+    return;
+  }
   if (have_sequence_) counts_.frames_lost += static_cast<std::uint8_t>(sequence - last_sequence_ - 1);
   have_sequence_ = true;
   last_sequence_ = sequence;

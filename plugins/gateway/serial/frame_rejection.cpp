@@ -16,6 +16,8 @@ const char* to_string(FrameRejection rejection) {
       return "unknown_version";
     case FrameRejection::kReservedBitsSet:
       return "reserved_bits_set";
+    case FrameRejection::kDuplicate:
+      return "duplicate";
     case FrameRejection::kTruncated:
       return "truncated";
   }

@@ -15,6 +15,7 @@ enum class FrameRejection : std::uint8_t {
   kUnknownType,      // beaconloc: a type version 1 does not define (judged on the header)
   kUnknownVersion,   // beaconloc: a version other than 1 (judged on the header)
   kReservedBitsSet,  // checksum good, but reserved flag bits or reserved bytes are not zero
+  kDuplicate,        // beaconloc: the sequence number of the frame before it (a frame sent twice)
   kTruncated,        // a frame begun when the line went away (FrameParser::reset_partial)
 };
 inline constexpr std::size_t kFrameRejectionCount = static_cast<std::size_t>(FrameRejection::kTruncated) + 1;

@@ -92,9 +92,11 @@ void LineSimulator::frames_of(const SourceEvent& e, std::vector<std::vector<std:
   }
 }
 
-bool LineSimulator::write_all(const std::uint8_t* data, std::size_t size) {
-  while (size > 0) {
-    if (!port_.is_open()) {
+bool LineSimulator::write_all(const std::uint8_t* data, std::size_t size, const std::atomic<bool>& stop) {
+  // A line nobody reads fills its buffer: the module's writes wait, then the frame is dropped
+  // (counted), and a stop is heard between waits.
+  for (int waits = 0; size > 0; ++waits) {
+    if (!port_.is_open() || stop || waits == 10) {
       ++counts_.dropped_device_gone;
       return false;
     }
@@ -131,17 +133,17 @@ void LineSimulator::send(const std::vector<std::uint8_t>& frame, StampNs source_
     std::uniform_int_distribution<int> length(1, 40), byte(0, 255);
     std::vector<std::uint8_t> garbage(static_cast<std::size_t>(length(random_)));
     for (auto& b : garbage) b = static_cast<std::uint8_t>(byte(random_));
-    write_all(garbage.data(), garbage.size());
+    write_all(garbage.data(), garbage.size(), stop);
     ++counts_.garbage_runs;
   }
   if (options_.split_frames && bytes.size() > 2 && !stop) {
     std::uniform_int_distribution<std::size_t> cut(1, bytes.size() - 1);
     const std::size_t at = cut(random_);
-    intact = write_all(bytes.data(), at) && intact;
+    intact = write_all(bytes.data(), at, stop) && intact;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the gateway reads the first piece alone
-    intact = write_all(bytes.data() + at, bytes.size() - at) && intact;
+    intact = write_all(bytes.data() + at, bytes.size() - at, stop) && intact;
   } else {
-    intact = write_all(bytes.data(), bytes.size()) && intact;
+    intact = write_all(bytes.data(), bytes.size(), stop) && intact;
   }
   ++counts_.frames;
   if (sample && intact) ++counts_.samples_intact;

@@ -42,7 +42,7 @@ struct LineSimulatorCounts {
   std::uint64_t garbage_runs = 0;
   std::uint64_t corrupted = 0;
   std::uint64_t dropped_in_stall = 0;
-  std::uint64_t dropped_device_gone = 0;  // written while the device was away
+  std::uint64_t dropped_device_gone = 0;  // written while the device was away or nobody read it
   std::uint64_t reopened = 0;
   std::uint64_t not_sendable =
       0;  // a sample the protocol cannot carry (a TOF beyond 4.29 s, a beacon id > 65535)
@@ -61,8 +61,9 @@ class LineSimulator {
   // sample: a TOF, distance or odometry frame (not a heartbeat).
   void send(const std::vector<std::uint8_t>& frame, StampNs source_ns, bool sample,
             const std::atomic<bool>& stop);
-  // False when the device went away before every byte was written.
-  bool write_all(const std::uint8_t* data, std::size_t size);
+  // False when the device went away, a stop came, or nobody read the line for a second, before
+  // every byte was written (counted dropped_device_gone).
+  bool write_all(const std::uint8_t* data, std::size_t size, const std::atomic<bool>& stop);
   // Distances frames carry one slot each: one sample per frame for either protocol.
   void frames_of(const SourceEvent& e, std::vector<std::vector<std::uint8_t>>& out);
   bool stalled(StampNs source_ns) const;

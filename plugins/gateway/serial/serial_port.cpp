@@ -128,6 +128,9 @@ SerialPort::OpenResult SerialPort::open() {
     return fail(OpenFailure::kOther, errno, "cfsetspeed");
   }
   if (::tcsetattr(fd_, TCSANOW, &tio) != 0) return fail(OpenFailure::kOther, errno, "tcsetattr");
+  // Bytes that waited in the driver while the port was closed would arrive late all at once and
+  // make the device clock's first offset wrong: the line is read from now on.
+  ::tcflush(fd_, TCIFLUSH);
   return result;
 }
 

@@ -81,7 +81,16 @@ void SerialSource::read_loop() {
       std::this_thread::sleep_for(kReopenPeriod);
       if (stop_) break;
       const serial::SerialPort::OpenResult opened = port_.open();
-      if (!opened.ok()) continue;
+      if (!opened.ok()) {
+        // Once per absence: a device back with the wrong permissions (udev not done yet) or held
+        // by another program is told; one simply not there yet is device_gone's.
+        if (!reopen_failure_counted_ && opened.failure != serial::SerialPort::OpenFailure::kMissing) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          counts_.reject("serial.reopen_failed");
+          reopen_failure_counted_ = true;
+        }
+        continue;
+      }
       std::lock_guard<std::mutex> lock(mutex_);
       counts_.reject("serial.reopened");  // counted as the line's event, not a sample refused
       spoken = stalled = false;
@@ -94,7 +103,8 @@ void SerialSource::read_loop() {
       counts_.reject("serial.device_gone");
       parser_.reset_partial();  // a frame cut by the unplug is counted truncated
       clock_.reset();           // the device that comes back may be another, its counter restarted
-      previous_odometry_device_ns_ = -1;
+      previous_odometry_ns_ = -1;
+      reopen_failure_counted_ = false;
       continue;
     }
     if (r.status != serial::SerialPort::Status::kData) {
@@ -123,10 +133,18 @@ void SerialSource::convert(const serial::Frame& frame) {
           },
           [&](const serial::OdometryFrame& o) {
             const StampNs stamp_ns = clock_.map(o.stamp_us, frame.arrival_ns);
-            const double dt_s = previous_odometry_device_ns_ < 0
-                                    ? options_.odometry_period_s
-                                    : ns_to_s(stamp_ns - previous_odometry_device_ns_);
-            previous_odometry_device_ns_ = stamp_ns;
+            if (clock_.counts().clock_resets != clock_resets_seen_) {
+              clock_resets_seen_ = clock_.counts().clock_resets;  // a new time line: no dT across it
+              previous_odometry_ns_ = -1;
+            }
+            const double dt_s = previous_odometry_ns_ < 0 ? options_.odometry_period_s
+                                                          : ns_to_s(stamp_ns - previous_odometry_ns_);
+            if (!(dt_s > 0.0)) {
+              // Not after the frame before it: no interval for the noise model, and no new sample.
+              counts_.reject("serial.odometry_not_after_previous");
+              return;
+            }
+            previous_odometry_ns_ = stamp_ns;
             SourceEvent e;
             e.kind = SourceEvent::Kind::kOdometry;
             e.stamp_ns = stamp_ns;
@@ -134,11 +152,9 @@ void SerialSource::convert(const serial::Frame& frame) {
             e.odometry.wheel_velocity_right_mps = o.right_mps;
             e.odometry.wheel_velocity_left_mps = o.left_mps;
             e.odometry.wheel_base_m = o.wheel_base_m;
-            // dT > 0: mapped stamps strictly increase with the device's (DeviceClock). A
-            // frame whose stamp did not advance gets a covariance the localizer refuses.
             const Eigen::Vector2d speeds(std::abs(o.right_mps), std::abs(o.left_mps));
             e.odometry.wheel_velocity_covariance = (options_.odometry_k_v_m * speeds / dt_s).asDiagonal();
-            pending_.push_back(e);
+            push(e);
           },
           [&](const serial::HeartbeatFrame& h) { clock_.map(h.stamp_us, frame.arrival_ns); },
           [&](const serial::DistancesFrame& d) {
@@ -153,6 +169,16 @@ void SerialSource::convert(const serial::Frame& frame) {
       frame.body);
 }
 
+void SerialSource::push(const SourceEvent& e) {
+  // A gateway that stopped taking must not make the reader grow without bound: beyond
+  // kMaxPending the oldest go, counted.
+  if (pending_.size() >= kMaxPending) {
+    pending_.erase(pending_.begin());
+    counts_.reject("serial.backlog_dropped");
+  }
+  pending_.push_back(e);
+}
+
 void SerialSource::add_tof(StampNs fire_ns, double tof_s, std::uint32_t beacon_id, std::uint32_t receiver_id,
                            double temperature_c) {
   SourceEvent e;
@@ -164,20 +190,18 @@ void SerialSource::add_tof(StampNs fire_ns, double tof_s, std::uint32_t beacon_i
   e.tof.beacon_temperature_c = temperature_c;
   e.tof.sequence_number = sequence_++;
   e.stamp_ns = fire_ns + s_to_ns(tof_s);
-  pending_.push_back(e);
+  push(e);
 }
 
-void SerialSource::advance(StampNs until_ns, std::vector<SourceEvent>& out) {
+void SerialSource::advance(StampNs /*until_ns*/, std::vector<SourceEvent>& out) {
   std::lock_guard<std::mutex> lock(mutex_);
-  // Live: what has arrived is given at once, in stamp order among itself. A frame's mapped stamp
-  // is at most its arrival (the mapping follows the smallest delay), so until_ns, the gateway's
-  // wall clock, holds back nothing but frames from a host clock stepped backwards.
+  // Live: what has arrived goes out at once, in stamp order among itself. The gateway's step time
+  // is not the frames' clock (it starts when the gateway does, and a host clock that steps moves
+  // the frames' stamps, not it): holding frames back by it would only delay them.
   std::stable_sort(pending_.begin(), pending_.end(),
                    [](const SourceEvent& a, const SourceEvent& b) { return a.stamp_ns < b.stamp_ns; });
-  auto split = std::partition_point(pending_.begin(), pending_.end(),
-                                    [until_ns](const SourceEvent& e) { return e.stamp_ns <= until_ns; });
-  out.insert(out.end(), pending_.begin(), split);
-  pending_.erase(pending_.begin(), split);
+  out.insert(out.end(), pending_.begin(), pending_.end());
+  pending_.clear();
 }
 
 RejectionCounter SerialSource::input_rejections() const {

@@ -6,7 +6,8 @@
 //  - a Marvelmind distance: RawTof at the reference temperature, tof = range / c(T), as a replayed
 //    range travels (docs/replay-format.md), stamped at the measurement's mapped time;
 //  - an odometry frame: Odometry, with seed 000's noise per wheel, sigma^2 = k_v |v| / dT, dT the
-//    device time since the previous odometry frame (the nominal period for the first of a line);
+//    mapped time since the previous odometry frame (the nominal period for the first of a line or
+//    of a device clock's new time line); a frame not after the one before is refused, counted;
 //  - a heartbeat: nothing (it keeps the clock mapping).
 // A reader thread reads the line; a device that goes away (USB unplugged) is reopened every
 // kReopenPeriod. What the line did wrong is counted by reason (input_rejections, in the
@@ -46,6 +47,9 @@ class SerialSource final : public Source {
   // No byte for this long, after the line spoke, is a stalled line, counted once per stall: a
   // receiver sends a heartbeat at least every 100 ms (docs/serial-protocol.md), so three are missing.
   static constexpr StampNs kStalledNs = 300 * kNsPerMillisecond;
+  // Events held for the gateway: 10 s of a busy line (100 Hz odometry, 3 receivers at 5 Hz), far
+  // more than the 10 ms between the gateway's steps.
+  static constexpr std::size_t kMaxPending = 2000;
 
   using Clock = std::function<StampNs()>;  // the host's time, ns since the epoch
   // Opens the device (a missing one is waited for, counted) and starts reading. Throws
@@ -69,6 +73,7 @@ class SerialSource final : public Source {
   void read_loop();
   // Under mutex_: the frames of one read, as events.
   void convert(const serial::Frame& frame);
+  void push(const SourceEvent& e);
   void add_tof(StampNs fire_ns, double tof_s, std::uint32_t beacon_id, std::uint32_t receiver_id,
                double temperature_c);
 
@@ -81,7 +86,9 @@ class SerialSource final : public Source {
   serial::DeviceClock clock_;
   std::vector<SourceEvent> pending_;
   std::uint64_t sequence_ = 0;
-  StampNs previous_odometry_device_ns_ = -1;
+  StampNs previous_odometry_ns_ = -1;  // the mapped stamp of the line's previous odometry frame
+  std::uint64_t clock_resets_seen_ = 0;
+  bool reopen_failure_counted_ = false;  // the reader thread's
   RejectionCounter counts_;  // the line's own: gone, reopened, stalled, open failures
   std::atomic<bool> stop_{false};
   std::thread reader_;  // last: stops before what it uses goes

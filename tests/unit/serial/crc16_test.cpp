@@ -37,7 +37,7 @@ TEST(SerialCrc16, ModbusOverAWholePacketSentLowByteFirstIsZero) {
 
 TEST(SerialFrameRejection, EveryReasonHasItsStableSnakeCaseName) {
   const char* expected[] = {"garbage",         "bad_checksum",      "bad_length", "unknown_type",
-                            "unknown_version", "reserved_bits_set", "truncated"};
+                            "unknown_version", "reserved_bits_set", "duplicate",  "truncated"};
   ASSERT_EQ(sizeof expected / sizeof expected[0], kFrameRejectionCount);
   for (std::size_t i = 0; i < kFrameRejectionCount; ++i) {
     EXPECT_STREQ(to_string(static_cast<FrameRejection>(i)), expected[i]);

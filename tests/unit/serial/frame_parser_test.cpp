@@ -184,6 +184,21 @@ TEST(SerialFrameParser, SequenceGapsAreCountedAsFramesLostAcrossTheWrap) {
   EXPECT_EQ(parser.counts().frames_lost, 2u + 245u);  // 1 and 2; 5 to 249
 }
 
+// A frame sent twice (its sequence number that of the frame before it) is taken once: counted a
+// duplicate, not 255 frames lost.
+TEST(SerialFrameParser, AFrameSentTwiceIsTakenOnceAndCountedDuplicate) {
+  FrameParser parser(Protocol::kBeaconloc);
+  std::vector<std::uint8_t> bytes;
+  for (int sequence : {7, 8, 8, 9}) {
+    const auto frame =
+        encode(HeartbeatFrame{static_cast<std::uint32_t>(sequence)}, static_cast<std::uint8_t>(sequence));
+    bytes.insert(bytes.end(), frame.begin(), frame.end());
+  }
+  EXPECT_EQ(parse(parser, bytes).size(), 3u);
+  EXPECT_EQ(parser.counts().rejections(FrameRejection::kDuplicate), 1u);
+  EXPECT_EQ(parser.counts().frames_lost, 0u);
+}
+
 // A frame's arrival is the host time of the read that completed it.
 TEST(SerialFrameParser, ArrivalIsTheReadThatCompletedTheFrame) {
   FrameParser parser(Protocol::kBeaconloc);
