@@ -89,8 +89,12 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
                                                       [this](const msg::PoseEstimate& m) { on_pose(m); }));
   readers_.push_back(participant_.subscribe<msg::OdometryPubSubType>(dds::kOdometryTopic,
                                                   [this](const msg::Odometry& m) { on_odometry(m); }));
-  readers_.push_back(participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic,
-                                                   [this](const msg::BeaconMap& m) { on_beacon_map(m); }));
+  map_reader_ = std::make_unique<dds::FirstSampleWatch>([this](std::function<void()> heard) {
+    return participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [this, heard](const msg::BeaconMap& m) {
+      heard();
+      on_beacon_map(m);
+    });
+  });
   readers_.push_back(participant_.subscribe<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic,
                                                      [this](const msg::BeaconRange& m) { on_range(m); }));
   publish_static_frames();
@@ -277,7 +281,9 @@ msg::Diagnostics BridgeParticipant::diagnostics_snapshot() {
         std::to_string(std::chrono::duration_cast<std::chrono::seconds>(now - *last_pose_received_).count()) +
         " s: the localizer is gone or silent";
   }
-  return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts_, 0, status, message);
+  RejectionCounter counts = counts_;
+  counts.reject(dds::kMapReaderRecreated, map_reader_->recreated());
+  return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, 0, status, message);
 }
 
 }  // namespace beaconloc::bridge
