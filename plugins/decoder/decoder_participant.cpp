@@ -21,7 +21,7 @@ DecoderParticipant::DecoderParticipant(const dds::DdsOptions& dds, TofDecoderCon
       }
       for (const auto& range : held) publish(range);
     });
-  });
+  }, [this] { return tofs_processed_.load() > 0; });  // the gateway heard: its map should come too
   dds::ReaderEvents<msg::RawTof> tof_events;
   tof_events.deadline_misses = &deadline_misses_;
   tof_events.writers_lost = &tof_writers_lost_;

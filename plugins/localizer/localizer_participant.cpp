@@ -120,7 +120,7 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
           }
         },
         map_events);
-  });
+  }, [this] { return odometry_processed_.load() + ranges_processed_.load() > 0; });  // a gateway heard
   // Other localizers' calibrations (its own comes back too: not news). Each sample is a site's
   // whole calibration; its groups replace the ones held (LocalizerCore::on_calibration).
   readers_.push_back(participant_.subscribe_with_info<msg::BeaconCalibrationPubSubType>(

@@ -88,6 +88,18 @@ class Security : public ParticipantsTest {
     }
     ParticipantsTest::TearDown();
   }
+  // robot's odometry writer in its partition, once matched to the localizer's reader. Created once
+  // more, said on stdout, when the first never matches in 15 s: Fast DDS 2.9's secured endpoint
+  // matching now and then never completes for a pair (docs/security.md), which is not what these
+  // tests are about.
+  static dds::Writer matched_odometry_writer(dds::Participant& p, const std::string& robot) {
+    for (int attempt = 1;; ++attempt) {
+      dds::Writer w = p.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, robot);
+      if (dds::wait_for_matched_readers({w}, scaled(std::chrono::seconds(15)))) return w;
+      if (attempt == 2) return dds::Writer();
+      std::cout << "the attacker's writer never matched (Fast DDS 2.9 secured matching): created again\n";
+    }
+  }
   // NaN odometry of `robot`, `count` samples 10 ms apart, written by `writer`.
   void write_nan_odometry(const dds::Writer& writer, const std::string& robot, int count) {
     for (int i = 0; i < count; ++i) {
@@ -202,8 +214,8 @@ TEST_F(Security, AnotherRobotsGatewayCannotGetSamplesIntoThisRobotsEstimate) {
                dds::DdsError);
   EXPECT_THROW((void)robot2.writer<msg::OdometryPubSubType>(dds::kOdometryTopic), dds::DdsError);
   // Its own robot's samples reach the localizer (refused for their NaN: counted): the path is up.
-  auto odometry = robot2.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, "robot2");
-  ASSERT_TRUE(dds::wait_for_matched_readers({odometry}, scaled(15s))) << localizer_->log();
+  auto odometry = matched_odometry_writer(robot2, "robot2");
+  ASSERT_TRUE(odometry) << "robot2's writer never matched\n" << localizer_->log();
   const std::uint64_t delivered = deliver(diagnostics, odometry, "robot2");
   ASSERT_GT(delivered, 0u) << "robot2's gateway never reached the localizer\n" << localizer_->log();
   // In its own partition, samples that say robot1: refused by the reader, counted, never fused.
@@ -305,8 +317,8 @@ TEST_F(Security, TamperedMessagesAreDroppedAndCounted) {
   dds::DdsOptions o = as("/beaconloc/gateway/robot2");
   o.transport = std::make_shared<TamperingTransportDescriptor>(tamper);
   dds::Participant robot2(o, "test.tampered");
-  auto odometry = robot2.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, "robot2");
-  ASSERT_TRUE(dds::wait_for_matched_readers({odometry}, scaled(15s))) << localizer_->log();
+  auto odometry = matched_odometry_writer(robot2, "robot2");
+  ASSERT_TRUE(odometry) << "robot2's writer never matched\n" << localizer_->log();
   // Intact, its samples arrive (refused for their NaN: counted).
   const std::uint64_t delivered = deliver(diagnostics, odometry, "robot2");
   ASSERT_GT(delivered, 0u) << "robot2's gateway never reached the localizer\n" << localizer_->log();

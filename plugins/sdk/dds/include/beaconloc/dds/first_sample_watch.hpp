@@ -1,7 +1,8 @@
 #pragma once
 // A reader whose topic must deliver (the beacon map: a decoder or localizer without it does
-// nothing), recreated when it stays mute: matched to a writer for kMuteAfter without a single
-// sample. Fast DDS 2.9 leaves a secured writer-reader pair mute now and then (about 1 start in 20
+// nothing), recreated when it stays mute: for kMuteAfterNs without a single sample while there is
+// a writer to hear, that is while it is matched, or while the peers are heard on other topics
+// (the gateway's TOFs reach a decoder that has no map: the map's pair never matched). Fast DDS 2.9 leaves a secured writer-reader pair mute now and then (about 1 start in 20
 // on a loaded machine: the key exchange of that one pair never completes, while the participants'
 // other pairs work); a new reader is a new pair, whose exchange starts afresh, and the writer's
 // transient-local history gives it the map. Each recreation is counted (recreated()).
@@ -28,7 +29,9 @@ class FirstSampleWatch {
   static constexpr std::int64_t kMuteAfterNs = 3'000'000'000;
   // make(heard): creates the reader; its callback calls heard() for every sample it takes.
   using Make = std::function<Reader(std::function<void()> heard)>;
-  explicit FirstSampleWatch(Make make) : make_(std::move(make)) {
+  // peers_heard: whether the participant hears the peers that also write this topic (may be empty).
+  explicit FirstSampleWatch(Make make, std::function<bool()> peers_heard = {})
+      : make_(std::move(make)), peers_heard_(std::move(peers_heard)) {
     reader_ = make_([this] { heard_ = true; });
     checks_ = std::make_unique<PeriodicTask>(std::chrono::milliseconds(500), [this] { check(); });
   }
@@ -48,8 +51,8 @@ class FirstSampleWatch {
     eprosima::fastdds::dds::SubscriptionMatchedStatus status;
     reader_->get_subscription_matched_status(status);
     const std::int64_t now = steady_clock_ns();
-    if (status.current_count == 0) {
-      matched_since_ns_ = -1;
+    if (status.current_count == 0 && !(peers_heard_ && peers_heard_())) {
+      matched_since_ns_ = -1;  // nobody to hear yet: waiting is not muteness
       return;
     }
     if (matched_since_ns_ < 0) matched_since_ns_ = now;
@@ -61,10 +64,11 @@ class FirstSampleWatch {
   }
 
   Make make_;
+  std::function<bool()> peers_heard_;
   std::atomic<bool> heard_{false};
   std::atomic<std::uint64_t> recreated_{0};
   std::mutex mutex_;
-  std::int64_t matched_since_ns_ = -1;
+  std::int64_t matched_since_ns_ = -1;  // since when there was a writer to hear
   Reader reader_;
   std::unique_ptr<PeriodicTask> checks_;  // last: stops before what it uses goes
 };
