@@ -27,6 +27,9 @@ class FirstSampleWatch {
   // The gateway writes its map at once on a match and again each second for 10 s: a working pair
   // delivers within a second or two. Three seconds without a sample is a mute pair.
   static constexpr std::int64_t kMuteAfterNs = 3'000'000'000;
+  // A pair not matched at all while the peers are heard: secured discovery of one pair can take
+  // several seconds on a loaded machine, and a new reader starts it again; so longer.
+  static constexpr std::int64_t kUnmatchedAfterNs = 10'000'000'000;
   // make(heard): creates the reader; its callback calls heard() for every sample it takes.
   using Make = std::function<Reader(std::function<void()> heard)>;
   // peers_heard: whether the participant hears the peers that also write this topic (may be empty).
@@ -51,12 +54,13 @@ class FirstSampleWatch {
     eprosima::fastdds::dds::SubscriptionMatchedStatus status;
     reader_->get_subscription_matched_status(status);
     const std::int64_t now = steady_clock_ns();
-    if (status.current_count == 0 && !(peers_heard_ && peers_heard_())) {
+    const bool matched = status.current_count > 0;
+    if (!matched && !(peers_heard_ && peers_heard_())) {
       matched_since_ns_ = -1;  // nobody to hear yet: waiting is not muteness
       return;
     }
     if (matched_since_ns_ < 0) matched_since_ns_ = now;
-    if (now - matched_since_ns_ < kMuteAfterNs) return;
+    if (now - matched_since_ns_ < (matched ? kMuteAfterNs : kUnmatchedAfterNs)) return;
     reader_.reset();  // waits for a callback under way
     reader_ = make_([this] { heard_ = true; });
     matched_since_ns_ = -1;
