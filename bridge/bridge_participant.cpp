@@ -69,18 +69,19 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
   ranges_writer_ = participant_.writer<sensor_msgs::msg::RangePubSubType>(
       {ranges_topic_.c_str(), "ros2.beacon_ranges.writer", ""});
   if (options_.odometry_in) {
-    odometry_in_writer_ = participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic);
+    odometry_in_writer_ = participant_.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, options_.robot_id);
     readers_.push_back(participant_.subscribe<nav_msgs::msg::OdometryPubSubType>(
         {odom_in_topic_.c_str(), "", "ros2.odom.reader"},
         [this](const nav_msgs::msg::Odometry& m) { on_ros_odometry(m); }));
   }
   if (options_.scan_in) {
-    scan_in_writer_ = participant_.writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic);
+    scan_in_writer_ = participant_.robot_writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic, options_.robot_id);
     readers_.push_back(participant_.subscribe<sensor_msgs::msg::LaserScanPubSubType>(
         {scan_in_topic_.c_str(), "", "ros2.scan.reader"},
         [this](const sensor_msgs::msg::LaserScan& m) { on_ros_scan(m); }));
   }
-  initial_pose_writer_ = participant_.writer<msg::InitialPosePubSubType>(dds::kInitialPoseTopic);
+  initial_pose_writer_ =
+      participant_.robot_writer<msg::InitialPosePubSubType>(dds::kInitialPoseTopic, options_.robot_id);
   readers_.push_back(participant_.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
       {initial_pose_topic_.c_str(), "", "ros2.initialpose.reader"},
       [this](const geometry_msgs::msg::PoseWithCovarianceStamped& m) { on_ros_initial_pose(m); }));
@@ -88,8 +89,12 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
                                                       [this](const msg::PoseEstimate& m) { on_pose(m); }));
   readers_.push_back(participant_.subscribe<msg::OdometryPubSubType>(dds::kOdometryTopic,
                                                   [this](const msg::Odometry& m) { on_odometry(m); }));
-  readers_.push_back(participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic,
-                                                   [this](const msg::BeaconMap& m) { on_beacon_map(m); }));
+  map_reader_ = std::make_unique<dds::FirstSampleWatch>([this](std::function<void()> heard) {
+    return participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [this, heard](const msg::BeaconMap& m) {
+      heard();
+      on_beacon_map(m);
+    });
+  });
   readers_.push_back(participant_.subscribe<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic,
                                                      [this](const msg::BeaconRange& m) { on_range(m); }));
   publish_static_frames();
@@ -276,7 +281,9 @@ msg::Diagnostics BridgeParticipant::diagnostics_snapshot() {
         std::to_string(std::chrono::duration_cast<std::chrono::seconds>(now - *last_pose_received_).count()) +
         " s: the localizer is gone or silent";
   }
-  return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts_, 0, status, message);
+  RejectionCounter counts = counts_;
+  counts.reject(dds::kMapReaderRecreated, map_reader_->recreated());
+  return dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, 0, status, message);
 }
 
 }  // namespace beaconloc::bridge

@@ -22,6 +22,7 @@
 #include "beaconloc/core/receiver_array.hpp"
 #include "beaconloc/core/rejection_counter.hpp"
 #include "beaconloc/dds/diagnostics_publisher.hpp"
+#include "beaconloc/dds/first_sample_watch.hpp"
 #include "beaconloc/dds/participant.hpp"
 #include "odom_frame.hpp"
 #include "pending_transforms.hpp"
@@ -99,6 +100,8 @@ class BridgeParticipant {
   dds::Writer odometry_in_writer_;
   dds::Writer scan_in_writer_;
   dds::Writer initial_pose_writer_;
+  // Before diagnostics_, which reports its count: it goes after the Diagnostics task stops.
+  std::unique_ptr<dds::FirstSampleWatch> map_reader_;  // recreated when mute (first_sample_watch.hpp)
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
   std::vector<dds::Reader> readers_;  // last: they stop before what their callbacks use goes
 };

@@ -74,13 +74,15 @@ awk -v quick="$quick" '
 { echo "benchmark,case,metric,value,unit"; cat "$out/estimators.rows"; } > "$csv"
 rm -f "$out/estimators.rows"
 
-# 2. End-to-end latency against the raw DDS hop, shared memory and UDP loopback, in one run
-#    (benchmarks/latency/main.cpp says what is measured); it writes its own medians (e2e_latency).
+# 2. End-to-end latency against the raw DDS hop, shared memory and UDP loopback, each without and
+#    with DDS Security, interleaved in one run (benchmarks/latency/main.cpp says what is measured,
+#    CPU per sample included); it writes its own medians (e2e_latency).
 echo "== end-to-end latency"
 if [ "$quick" = 1 ]; then
-  "$bin/latency/beaconloc_latency" --duration-s 3 --warmup-s 2 --hop-duration-s 2 --b2b-hop-s 1 --csv "$csv"
+  "$bin/latency/beaconloc_latency" --security both --duration-s 3 --warmup-s 2 --hop-duration-s 2 --b2b-hop-s 1 \
+    --csv "$csv"
 else
-  "$bin/latency/beaconloc_latency" --repeat "$repeat" --duration-s 40 --csv "$csv"
+  "$bin/latency/beaconloc_latency" --security both --repeat "$repeat" --duration-s 40 --csv "$csv"
 fi
 
 # 3. Robots served by one localizer process, and by the bare Fast DDS relay standing in for it

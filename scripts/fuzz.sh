@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 all_targets=(fuzz_scenario_yaml fuzz_map_yaml fuzz_replay_csv fuzz_eval_csv fuzz_decoder_input fuzz_cli_params
-  fuzz_beacon_map_msg)
+  fuzz_beacon_map_msg fuzz_serial_frames fuzz_bus_recording)
 seconds=60
 targets=()
 usage() { sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; }

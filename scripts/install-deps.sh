@@ -12,7 +12,14 @@ $SUDO apt-get install -y --no-install-recommends \
   libgtest-dev libgmock-dev libbenchmark-dev \
   cyclonedds-dev cyclonedds-tools \
   fastdds-tools iproute2 \
+  openssl libssl-dev \
+  libsqlite3-dev socat python3 python3-yaml \
   clang libclang-rt-14-dev llvm
+# libsqlite3-dev (beaconloc record writes rosbag2's sqlite3 storage), socat (the serial gateway's
+# tests: linked pseudo-terminals), python3 with python3-yaml (tests/tools/check_rosbag2.py, a reader
+# of those bags that shares no code with the writer).
+# openssl (scripts/deployment-keys.sh: a secured deployment's keys) and libssl-dev (dds/security.cpp
+# checks an enclave's certificates before Fast DDS does; Fast DDS's security plugins link it too).
 # fastdds-tools (fast-discovery-server) and iproute2 (ip netns): the multi-host tests, whose hosts
 # are network namespaces finding each other through two discovery servers (tests/multihost).
 # clang, libclang-rt-14-dev (libFuzzer, ASan and UBSan runtimes) and llvm (llvm-symbolizer, for

@@ -90,7 +90,10 @@ Outcome run(Mode mode, int shards, const Setup& s, int round) {
   const std::string profile = mode == Mode::kSimple ? "beaconloc.network" : "beaconloc.discovery_client";
   const std::string xml = mode == Mode::kSimple ? s.simple_xml : s.client_xml;
   hosts.enter(3);
-  dds::DdsOptions dds{s.domain_id, profile, {xml}};
+  dds::DdsOptions dds;
+  dds.domain_id = s.domain_id;
+  dds.participant_profile = profile;
+  dds.extra_qos_files = {xml};
   testing::ShardWatcher watcher(dds);
   const NetnsHosts::WireTotals before = hosts.sent();
   const Clock::time_point started = Clock::now();

@@ -18,6 +18,14 @@ void check_stop() {
   if (dds::stop_requested()) throw Stopped();
 }
 
+dds::DdsOptions bench_dds_options(int domain, const Transport& t) {
+  dds::DdsOptions o;
+  o.domain_id = domain;
+  o.participant_profile = t.profile;
+  if (!t.keystore.empty()) o.security = {t.keystore, kBenchEnclave};
+  return o;
+}
+
 int matched_readers(eprosima::fastdds::dds::DataWriter* w) {
   eprosima::fastdds::dds::PublicationMatchedStatus s;
   w->get_publication_matched_status(s);

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "beaconloc/dds/participant.hpp"
+
 namespace eprosima::fastdds::dds {
 class DataReader;
 class DataWriter;
@@ -21,9 +23,18 @@ constexpr int kPipelineHops = 3;
 constexpr const char* kRobotId = "robot1";
 
 struct Transport {
-  std::string name;     // shm, udp
+  std::string name;     // shm, udp, shm+security, udp+security
   std::string profile;  // participant profile (examples/qos/loopback.xml)
+  // DDS Security on with this keystore (scripts/deployment-keys.sh): this process and the echo as
+  // enclave kBenchEnclave, the decoder and localizer as their roles'. Empty: off.
+  std::string keystore;
 };
+
+// The benchmark's identity in a secured run (the script's role "bench").
+constexpr const char* kBenchEnclave = "/beaconloc/bench";
+// The options of this process's participants (and the echo's) for transport t.
+dds::DdsOptions bench_dds_options(int domain, const Transport& t);
+
 
 struct Settings {
   std::string cli;   // the beaconloc executable (decoder and localizer)

@@ -38,6 +38,11 @@ Figures figures_of(const PipelineResult& pipeline, const HopResult& hop) {
   f.pose_rate_hz = pipeline.pose_rate_hz;
   f.pings = hop.sent;
   f.lost = hop.lost;
+  if (pipeline.window_samples && pipeline.window_s > 0.0) {
+    f.pipeline_cpu_us_per_sample = pipeline.children_cpu_s * 1e6 / static_cast<double>(pipeline.window_samples);
+    f.pipeline_cpu_percent = 100.0 * pipeline.children_cpu_s / pipeline.window_s;
+  }
+  if (hop.sent) f.echo_cpu_us_per_round_trip = hop.echo_cpu_s * 1e6 / static_cast<double>(hop.sent);
   return f;
 }
 
@@ -71,6 +76,9 @@ Figures median_of(const std::vector<Figures>& runs) {
   f.pose_rate_hz = m([](const Figures& x) { return x.pose_rate_hz; });
   f.pings = static_cast<std::size_t>(m([](const Figures& x) { return x.pings; }));
   f.lost = static_cast<std::size_t>(m([](const Figures& x) { return x.lost; }));
+  f.pipeline_cpu_us_per_sample = m([](const Figures& x) { return x.pipeline_cpu_us_per_sample; });
+  f.pipeline_cpu_percent = m([](const Figures& x) { return x.pipeline_cpu_percent; });
+  f.echo_cpu_us_per_round_trip = m([](const Figures& x) { return x.echo_cpu_us_per_round_trip; });
   return f;
 }
 
@@ -97,6 +105,10 @@ void print_figures(const std::string& transport, const Figures& f) {
       "%-9s matched %.1f %% of %zu timed TOFs (the first of each slot), %.1f %% of the matches by a "
       "correction pose; %zu TOFs and %zu poses (%.1f Hz) in all; %zu of %zu pings unanswered\n",
       t, 100.0 * f.matched, f.timed, 100.0 * f.corrections, f.tofs, f.poses, f.pose_rate_hz, f.lost, f.pings);
+  std::printf(
+      "%-9s CPU: decoder + localizer %.1f us per sample written to them (%.2f %% of a core); echo %.1f us per "
+      "round trip (clock ticks of 10 ms: coarse over short runs)\n",
+      t, f.pipeline_cpu_us_per_sample, f.pipeline_cpu_percent, f.echo_cpu_us_per_round_trip);
   std::fflush(stdout);
 }
 
@@ -116,6 +128,9 @@ void append_csv(const std::string& path, const std::string& benchmark, const std
   r.add("ratio_p99", f.ratio99, "ratio");
   r.add("matched_fraction", f.matched, "fraction");
   r.add("correction_pose_fraction", f.corrections, "fraction");
+  r.add("pipeline_cpu_per_sample", f.pipeline_cpu_us_per_sample, "us");
+  r.add("pipeline_cpu", f.pipeline_cpu_percent, "percent_of_core");
+  r.add("echo_cpu_per_round_trip", f.echo_cpu_us_per_round_trip, "us");
   if (f.b2b.n) {
     r.add("hop_b2b_p50", f.b2b.p50, "us");
     r.add("hop_b2b_p99", f.b2b.p99, "us");

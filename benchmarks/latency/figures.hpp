@@ -24,6 +24,9 @@ struct Figures {
   double matched = NAN, corrections = NAN;      // fractions of timed TOFs, of matches
   std::size_t timed = 0, tofs = 0, poses = 0, pings = 0, lost = 0;
   double pose_rate_hz = NAN;
+  // CPU: the decoder's and localizer's per sample written to them (TOFs and odometry) and in % of
+  // one core, over the measured window; the echo's per paced round trip (one read, one write).
+  double pipeline_cpu_us_per_sample = NAN, pipeline_cpu_percent = NAN, echo_cpu_us_per_round_trip = NAN;
 };
 
 // Nearest-rank p50 and p99 (bench::percentile) and the max.

@@ -30,6 +30,7 @@
 // domains are leased (testing::DomainLease) for the whole run.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -56,7 +57,8 @@ int main_impl(int argc, char** argv) {
   int domain = -1;
   std::string transport = "both";
   std::string role = "bench";
-  std::string echo_profile;
+  std::string echo_profile, echo_keystore;
+  std::string security = "plain";
   std::string csv_file;
   CLI::App app{
       "End-to-end latency: RawTof -> PoseEstimate through beaconloc decoder and localizer processes, next to "
@@ -91,10 +93,15 @@ int main_impl(int argc, char** argv) {
   app.add_option("--csv", csv_file, "append rows benchmark,transport,metric,value,unit to this file");
   app.add_option("--role", role, "internal: bench or echo")->check(CLI::IsMember({"bench", "echo"}));
   app.add_option("--profile", echo_profile, "internal: the echo's participant profile");
+  app.add_option("--keystore", echo_keystore, "internal: the echo's keystore (DDS Security)");
+  app.add_option("--security", security,
+                 "plain, secured (DDS Security: a keystore made by scripts/deployment-keys.sh in the log "
+                 "directory) or both, interleaved")
+      ->check(CLI::IsMember({"plain", "secured", "both"}));
   CLI11_PARSE(app, argc, argv);
   dds::install_stop_handlers();
 
-  if (role == "echo") return run_echo(domain, echo_profile);
+  if (role == "echo") return run_echo(domain, echo_profile, echo_keystore);
 
   // Held until the end: no other run on this machine gets these domains meanwhile.
   std::optional<testing::DomainLease> pipeline_lease, hop_lease;
@@ -115,9 +122,23 @@ int main_impl(int argc, char** argv) {
   } else {
     std::filesystem::create_directories(st.log_dir);
   }
+  std::string keystore;
+  if (security != "plain") {
+    keystore = st.log_dir + "/keystore";
+    const std::string make = "bash " BEACONLOC_SOURCE_DIR "/scripts/deployment-keys.sh deployment " + keystore +
+                             " " + kRobotId + " >/dev/null && bash " BEACONLOC_SOURCE_DIR
+                             "/scripts/deployment-keys.sh enclave " + keystore + " bench --enclave " +
+                             kBenchEnclave + " >/dev/null";
+    if (std::system(make.c_str()) != 0) throw std::runtime_error("cannot make the keystore: " + make);
+  }
   std::vector<Transport> transports;
-  if (transport != "udp") transports.push_back({"shm", "beaconloc.loopback"});
-  if (transport != "shm") transports.push_back({"udp", "beaconloc.loopback_udp"});
+  for (const bool secured : {false, true}) {
+    if (secured ? security == "plain" : security == "secured") continue;
+    const std::string suffix = secured ? "+sec" : "";
+    const std::string ks = secured ? keystore : "";
+    if (transport != "udp") transports.push_back({"shm" + suffix, "beaconloc.loopback", ks});
+    if (transport != "shm") transports.push_back({"udp" + suffix, "beaconloc.loopback_udp", ks});
+  }
 
   // The suite's layout (bench::Results: benchmark,case,metric,value,unit; here the case is the
   // transport), its header written when the file is new. Fail now rather than after the runs.

@@ -27,6 +27,7 @@
 #include "beaconloc/dds/participant.hpp"
 #include "beaconloc/dds/periodic_task.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
+#include "bench_support.hpp"
 #include "child.hpp"
 #include "sim/scenario.hpp"
 #include "sim/sim_source.hpp"
@@ -127,6 +128,12 @@ PipelineResult run_pipeline(const Settings& st, const Transport& t) {
                                         number(scenario.max_range_m),
                                         "--range-sigma-m",
                                         number(scenario.range_sigma_m)};
+  if (!t.keystore.empty()) {
+    for (auto* argv : {&localizer_argv, &decoder_argv}) {
+      argv->push_back("--keystore");
+      argv->push_back(t.keystore);
+    }
+  }
   Child localizer("localizer", localizer_argv, st.log_dir + "/" + t.name + "-localizer.log");
   Child decoder("decoder", decoder_argv, st.log_dir + "/" + t.name + "-decoder.log");
   std::vector<Child*> children{&localizer, &decoder};
@@ -140,13 +147,11 @@ PipelineResult run_pipeline(const Settings& st, const Transport& t) {
 
   PipelineResult result;
   {
-    dds::DdsOptions o;
-    o.domain_id = st.pipeline_domain;
-    o.participant_profile = t.profile;
-    dds::Participant participant(o, "beaconloc.latency.gateway");
+    dds::Participant participant(bench_dds_options(st.pipeline_domain, t), "beaconloc.latency.gateway");
     dds::Writer map_writer = participant.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
-    dds::Writer tof_writer = participant.writer<msg::RawTofPubSubType>(dds::kRawTofTopic);
-    dds::Writer odometry_writer = participant.writer<msg::OdometryPubSubType>(dds::kOdometryTopic);
+    dds::Writer tof_writer = participant.robot_writer<msg::RawTofPubSubType>(dds::kRawTofTopic, kRobotId);
+    dds::Writer odometry_writer =
+        participant.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, kRobotId);
     dds::Reader pose_reader = participant.subscribe<msg::PoseEstimatePubSubType>(
         dds::kPoseEstimateTopic, [&](const msg::PoseEstimate& m) {
           const std::int64_t arrival = now_ns();
@@ -182,10 +187,26 @@ PipelineResult run_pipeline(const Settings& st, const Transport& t) {
     std::vector<SourceEvent> events;
     const auto wall_start = Clock::now();
     StampNs next_check_ns = kNsPerSecond;
+    // The children's CPU over the measured window: read at its first and last step.
+    const auto children_cpu_s = [&] {
+      return bench::process_cpu_s(localizer.pid()) + bench::process_cpu_s(decoder.pid());
+    };
+    double window_cpu_start_s = 0.0;
+    Clock::time_point window_wall_start;
+    bool in_window = false;
     for (StampNs t_ns = 0; t_ns <= end_ns; t_ns += step_ns) {
       events.clear();
       source.advance(t_ns, events);
       std::this_thread::sleep_until(wall_start + std::chrono::nanoseconds(t_ns));
+      if (!in_window && t_ns >= warmup_ns && t_ns < measured_end_ns) {
+        in_window = true;
+        window_cpu_start_s = children_cpu_s();
+        window_wall_start = Clock::now();
+      } else if (in_window && t_ns >= measured_end_ns) {
+        in_window = false;
+        result.children_cpu_s = children_cpu_s() - window_cpu_start_s;
+        result.window_s = std::chrono::duration<double>(Clock::now() - window_wall_start).count();
+      }
       for (auto& e : events) {
         if (e.kind == SourceEvent::Kind::kTof) {
           const StampNs fire_ns = e.tof.fire_stamp_ns;
@@ -195,12 +216,14 @@ PipelineResult run_pipeline(const Settings& st, const Transport& t) {
           auto m = dds::to_msg(kRobotId, e.tof);
           const std::int64_t before = now_ns();
           if (!tof_writer->write(&m)) throw std::runtime_error("RawTof write failed");
+          if (in_window) ++result.window_samples;
           tofs.push_back(
               {before, e.tof.beacon_id, first_of_slot && fire_ns >= warmup_ns && fire_ns < measured_end_ns});
         } else if (e.kind == SourceEvent::Kind::kOdometry) {
           e.odometry.stamp_ns = e.stamp_ns + offset_ns;
           auto m = dds::to_msg(kRobotId, e.odometry, odometry_sequence++);
           if (!odometry_writer->write(&m)) throw std::runtime_error("Odometry write failed");
+          if (in_window) ++result.window_samples;
         }
       }
       if (t_ns >= next_check_ns) {  // once a second

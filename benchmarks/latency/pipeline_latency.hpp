@@ -15,6 +15,11 @@ struct PipelineResult {
   std::size_t tofs_written = 0;
   std::size_t poses = 0;
   double pose_rate_hz = 0.0;
+  // The decoder's and localizer's CPU time over the measured window, and the samples (TOFs and
+  // odometry) written to them in it.
+  double children_cpu_s = 0.0;
+  std::size_t window_samples = 0;
+  double window_s = 0.0;
 };
 
 // One run on st.pipeline_domain over transport t: st.warmup_s unmeasured, st.duration_s measured,

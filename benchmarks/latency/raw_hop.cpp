@@ -20,6 +20,7 @@
 #include "beaconloc/dds/periodic_task.hpp"
 #include "beaconloc/dds/stop_signal.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
+#include "bench_support.hpp"
 #include "child.hpp"
 
 namespace beaconloc::latency {
@@ -46,11 +47,8 @@ msg::RawTof ping_sample(std::uint64_t sequence) {
 
 }  // namespace
 
-int run_echo(int domain, const std::string& profile) {
-  dds::DdsOptions o;
-  o.domain_id = domain;
-  o.participant_profile = profile;
-  dds::Participant participant(o, "beaconloc.latency.echo");
+int run_echo(int domain, const std::string& profile, const std::string& keystore) {
+  dds::Participant participant(bench_dds_options(domain, {"echo", profile, keystore}), "beaconloc.latency.echo");
   dds::Writer pong = participant.writer<msg::RawTofPubSubType>(kPongTopic);
   dds::Reader reader = participant.subscribe<msg::RawTofPubSubType>(kPingTopic, [&pong](const msg::RawTof& m) {
     msg::RawTof copy = m;
@@ -63,15 +61,17 @@ int run_echo(int domain, const std::string& profile) {
 
 HopResult run_hop(const Settings& st, const Transport& t) {
   const int domain = st.hop_domain;
-  Child echo("echo", {st.self, "--role", "echo", "--domain", std::to_string(domain), "--profile", t.profile},
-             st.log_dir + "/" + t.name + "-echo.log");
+  std::vector<std::string> echo_argv{st.self,    "--role",   "echo", "--domain", std::to_string(domain),
+                                     "--profile", t.profile};
+  if (!t.keystore.empty()) {
+    echo_argv.push_back("--keystore");
+    echo_argv.push_back(t.keystore);
+  }
+  Child echo("echo", echo_argv, st.log_dir + "/" + t.name + "-echo.log");
   std::vector<Child*> children{&echo};
   HopResult result;
   {
-    dds::DdsOptions o;
-    o.domain_id = domain;
-    o.participant_profile = t.profile;
-    dds::Participant participant(o, "beaconloc.latency.ping");
+    dds::Participant participant(bench_dds_options(domain, t), "beaconloc.latency.ping");
     std::mutex mutex;
     std::condition_variable cv;
     std::uint64_t awaited = 0;
@@ -119,9 +119,11 @@ HopResult run_hop(const Settings& st, const Transport& t) {
     const auto measured =
         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(st.hop_duration_s));
     const auto begin = Clock::now();
+    std::optional<double> echo_cpu_start_s;
     for (auto next = begin; next - begin < warmup + measured; next += period) {
       std::this_thread::sleep_until(next);
       const bool timed = Clock::now() - begin >= warmup;
+      if (timed && !echo_cpu_start_s) echo_cpu_start_s = bench::process_cpu_s(echo.pid());
       const auto rtt = round_trip();
       if (timed) {
         ++result.sent;
@@ -136,6 +138,7 @@ HopResult run_hop(const Settings& st, const Transport& t) {
         require_alive(children);
       }
     }
+    if (echo_cpu_start_s) result.echo_cpu_s = bench::process_cpu_s(echo.pid()) - *echo_cpu_start_s;
     // Back-to-back, for reference (Fast DDS's figure on a hot path, TOOLCHAIN.md's ping-pong).
     const auto b2b = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(st.b2b_hop_s));
     const auto b2b_begin = Clock::now();

@@ -15,6 +15,8 @@ std::vector<std::unique_ptr<Command>> add_commands(CLI::App& app) {
   add_pipeline_commands(app, commands);
   add_offline_commands(app, commands);
   add_monitor_command(app, commands);
+  add_record_command(app, commands);
+  add_serial_sim_command(app, commands);
   return commands;
 }
 

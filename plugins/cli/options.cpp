@@ -17,7 +17,13 @@ OptionSet dds_option_set(dds::DdsOptions& o) {
       .text("--participant-profile", o.participant_profile,
             "participant profile of the QoS XML (default: loopback only)", {}, OptionSet::Written::kAlways)
       .texts("--qos", o.extra_qos_files, "extra Fast DDS XML profiles file(s), loaded last",
-             [](CLI::Option* option) { option->check(CLI::ExistingFile); });
+             [](CLI::Option* option) { option->check(CLI::ExistingFile); })
+      .text("--keystore", o.security.keystore,
+            "DDS Security on: the deployment's keystore (scripts/deployment-keys.sh; SROS2 layout)",
+            [](CLI::Option* option) { option->check(CLI::ExistingDirectory); })
+      .text("--enclave", o.security.enclave,
+            "the participant's identity in the keystore (default: its role's, e.g. /beaconloc/decoder; "
+            "not with run or demo, whose participants each take their own)");
   return set;
 }
 
@@ -55,7 +61,11 @@ OptionSet gateway_option_set(GatewayOptions& o, std::optional<std::uint64_t>& se
       .unsigned_number("--seed", seed, "random seed of the simulated noise (default: the scenario's)")
       .text("--truth-out", o.truth_csv, "write ground truth CSV here")
       .text("--firings-out", o.firings_csv,
-            "write every beacon firing as CSV here (fire_stamp_ns,beacon_id,planned,heard)");
+            "write every beacon firing as CSV here (fire_stamp_ns,beacon_id,planned,heard)")
+      .whole("--wait-for-readers", o.wait_for_readers,
+             "before the first sample, wait for this many readers besides the run's own (for gateway: in all) on the "
+             "TOF (or pulse) and odometry topics: a recorder, a second localizer",
+             whole_in(0, GatewayOptions::kMaxWaitForReaders));
   return set;
 }
 

@@ -9,7 +9,7 @@
 
 namespace beaconloc::cli {
 
-// --domain, --participant-profile, --qos
+// --domain, --participant-profile, --qos, --keystore, --enclave
 OptionSet dds_option_set(dds::DdsOptions& o);
 // --scenario, --replay (exclusive), --replay-wheel-base-m, --replay-odometry-k-v, --fault
 OptionSet source_option_set(SourceChoice& s);

@@ -365,8 +365,13 @@ PipelineResult run_in_one_process(const PipelineOptions& o, LoadedSource source)
     }
   };
   LoadedSource described{source.choice, source.seed, nullptr, source.scenario, source.label};
+  GatewayOptions gateway_options = o.gateway;
+  // --wait-for-readers counts readers besides the run's own: the decoder (or, of pulses, the
+  // localizer) on the beacons' topic; the localizer and the bridge on odometry.
+  gateway_options.own_beacon_readers = 1;
+  gateway_options.own_odometry_readers = ros2_bridge ? 2 : 1;
   gateway = std::make_unique<GatewayParticipant>(
-      o.dds, o.gateway, std::move(source.source),
+      o.dds, gateway_options, std::move(source.source),
       [&](StampNs stamp, const Pose2& pose, bool has_yaw) {
         std::lock_guard<std::mutex> lock(truth_mutex);
         truth.add(stamp, pose, has_yaw);
@@ -456,6 +461,9 @@ PipelineResult run_in_processes(const PipelineOptions& o, LoadedSource source, c
       command_line("decoder", dds_option_set(dds), decoder_option_set(decoder_config, max_age_ms));
   GatewayOptions gateway_options = o.gateway;
   gateway_options.truth_csv = o.out_dir + "/truth.csv";
+  // Besides the run's own readers (its decoder or localizer on the beacons' topic, its localizer on
+  // odometry): one each. The child gets the total, its own being none.
+  if (gateway_options.wait_for_readers > 0) gateway_options.wait_for_readers += 1;
   std::optional<std::uint64_t> seed = o.gateway.seed;
   SourceChoice choice = source.choice;
   const std::vector<std::string> gateway_args = command_line(

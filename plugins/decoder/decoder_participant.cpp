@@ -11,14 +11,17 @@ DecoderParticipant::DecoderParticipant(const dds::DdsOptions& dds, TofDecoderCon
     : decoder_(config),
       participant_(dds, "beaconloc.decoder"),
       range_writer_(participant_.writer<msg::BeaconRangePubSubType>(dds::kBeaconRangeTopic)) {
-  map_reader_ = participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [this](const msg::BeaconMap& m) {
-    std::vector<DecodedRange> held;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      held = decoder_.on_beacon_map(dds::from_msg(m));
-    }
-    for (const auto& range : held) publish(range);
-  });
+  map_reader_ = std::make_unique<dds::FirstSampleWatch>([this](std::function<void()> heard) {
+    return participant_.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [this, heard](const msg::BeaconMap& m) {
+      heard();
+      std::vector<DecodedRange> held;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        held = decoder_.on_beacon_map(dds::from_msg(m));
+      }
+      for (const auto& range : held) publish(range);
+    });
+  }, [this] { return tofs_processed_.load() > 0; });  // the gateway heard: its map should come too
   dds::ReaderEvents<msg::RawTof> tof_events;
   tof_events.deadline_misses = &deadline_misses_;
   tof_events.writers_lost = &tof_writers_lost_;
@@ -66,8 +69,10 @@ msg::Diagnostics DecoderParticipant::diagnostics_snapshot() {
     status = msg::PARTICIPANT_STATUS_DEGRADED;
     message = "no live TOF writer: the gateway was lost";
   }
-  auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), decoder_.counts(),
-                                 deadline_misses_.load(), status, message);
+  RejectionCounter counts = decoder_.counts();
+  counts.reject(dds::kMapReaderRecreated, map_reader_->recreated());
+  auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, deadline_misses_.load(), status,
+                                 message);
   d.writers_lost(tof_writers_lost_.load());
   return d;
 }

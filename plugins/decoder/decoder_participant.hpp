@@ -7,6 +7,7 @@
 #include <mutex>
 
 #include "beaconloc/dds/diagnostics_publisher.hpp"
+#include "beaconloc/dds/first_sample_watch.hpp"
 #include "beaconloc/dds/participant.hpp"
 #include "tof_decoder.hpp"
 
@@ -44,8 +45,9 @@ class DecoderParticipant {
   // The entities, owned: the readers, declared last, stop first, before what they use goes.
   dds::Participant participant_;
   dds::Writer range_writer_;
+  // Before diagnostics_, which reports its count: it goes after the Diagnostics task stops.
+  std::unique_ptr<dds::FirstSampleWatch> map_reader_;  // recreated when mute (first_sample_watch.hpp)
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
-  dds::Reader map_reader_;
   dds::Reader tof_reader_;
 };
 

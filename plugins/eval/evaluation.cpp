@@ -220,16 +220,32 @@ void write_estimates_csv(const std::string& path, const std::vector<EstimateRow>
   }
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write '" + path + "'");
-  for (std::size_t i = 0; i < kEstimateColumns.size(); ++i) out << (i ? "," : "") << kEstimateColumns[i];
-  out << '\n' << std::setprecision(12);
-  for (const auto& r : rows) {
-    const auto& e = r.estimate;
-    out << r.robot_id << ',' << e.stamp_ns << ',' << e.pose_map_base.x() << ',' << e.pose_map_base.y() << ','
-        << e.pose_map_base.z();
-    for (int i = 0; i < 9; ++i) out << ',' << e.covariance(i / 3, i % 3);
-    out << ',' << to_string(e.status) << ',' << r.estimator << '\n';
+  std::string text = estimates_csv_header() + '\n';
+  for (const auto& r : rows) text += estimates_csv_row(r) + '\n';
+  if (!(out << text).flush()) throw std::runtime_error("writing '" + path + "' failed");
+}
+
+std::string estimates_csv_header() {
+  std::string header;
+  for (std::size_t i = 0; i < kEstimateColumns.size(); ++i) header += (i ? "," : "") + std::string(kEstimateColumns[i]);
+  return header;
+}
+
+std::string estimates_csv_row(const EstimateRow& r) {
+  // Numbers in the shortest text that reads back to the same double: two runs' files are equal
+  // exactly when their estimates are.
+  const auto& e = r.estimate;
+  std::string row = r.robot_id + ',' + std::to_string(e.stamp_ns);
+  for (double v : {e.pose_map_base.x(), e.pose_map_base.y(), e.pose_map_base.z()}) {
+    row += ',';
+    append_decimal(row, v);
   }
-  if (!out.flush()) throw std::runtime_error("writing '" + path + "' failed");
+  for (int i = 0; i < 9; ++i) {
+    row += ',';
+    append_decimal(row, e.covariance(i / 3, i % 3));
+  }
+  row += ',' + std::string(to_string(e.status)) + ',' + r.estimator;
+  return row;
 }
 
 void write_metrics_json(const std::string& path, const Metrics& m, const std::string& estimator,

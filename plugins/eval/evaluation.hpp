@@ -69,6 +69,9 @@ std::vector<ErrorPoint> error_series(const TruthTrack& truth, const std::vector<
 TruthTrack load_truth_csv(const std::string& path);
 std::vector<EstimateRow> load_estimates_csv(const std::string& path);
 void write_estimates_csv(const std::string& path, const std::vector<EstimateRow>& rows);
+// estimate.csv's header and one row (without '\n'), for a writer of its own (beaconloc record).
+std::string estimates_csv_header();
+std::string estimates_csv_row(const EstimateRow& row);
 void write_metrics_json(const std::string& path, const Metrics& m, const std::string& estimator,
                         const std::string& source);
 

@@ -21,11 +21,12 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
       on_truth_(std::move(on_truth)),
       throttle_(std::move(throttle)),
       participant_(dds, "beaconloc.gateway." + options_.robot_id),
-      map_writer_(participant_.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic)),
-      tof_writer_(participant_.writer<msg::RawTofPubSubType>(dds::kRawTofTopic)),
-      pulse_writer_(participant_.writer<msg::PulseArrivalPubSubType>(dds::kPulseArrivalTopic)),
-      odometry_writer_(participant_.writer<msg::OdometryPubSubType>(dds::kOdometryTopic)),
-      scan_writer_(participant_.writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic)) {
+      map_writer_(participant_.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, &map_readers_)),
+      // The robot's measurements, in its partition (a gateway's permissions grant it no other).
+      tof_writer_(participant_.robot_writer<msg::RawTofPubSubType>(dds::kRawTofTopic, options_.robot_id)),
+      pulse_writer_(participant_.robot_writer<msg::PulseArrivalPubSubType>(dds::kPulseArrivalTopic, options_.robot_id)),
+      odometry_writer_(participant_.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, options_.robot_id)),
+      scan_writer_(participant_.robot_writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic, options_.robot_id)) {
   if (source_->honours_firing_plan()) {
     const std::vector<std::uint32_t> every = fire_all(source_->beacon_map());
     scheduler_.emplace(source_->slot_period_ns(), std::set<std::uint32_t>(every.begin(), every.end()));
@@ -38,28 +39,19 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
     throw std::invalid_argument(why.str());
   }
   if (!(options_.duration_s >= 0.0)) throw std::invalid_argument("--duration-s must be >= 0");
+  if (options_.wait_for_readers < 0 || options_.wait_for_readers > GatewayOptions::kMaxWaitForReaders) {
+    throw std::invalid_argument("--wait-for-readers must be in [0, " +
+                                std::to_string(GatewayOptions::kMaxWaitForReaders) + "]");
+  }
   if (!options_.truth_csv.empty()) {
     truth_.open(options_.truth_csv);
     if (!truth_) throw std::runtime_error("cannot write truth file '" + options_.truth_csv + "'");
     truth_ << "stamp_ns,x_m,y_m,yaw_rad\n" << std::setprecision(10);
   }
   if (!options_.record_dir.empty()) {
-    record_tof_.open(options_.record_dir + "/tof.csv");
-    record_odometry_.open(options_.record_dir + "/odometry.csv");
-    if (!record_tof_ || !record_odometry_) {
-      throw std::runtime_error("cannot write tof.csv and odometry.csv in '" + options_.record_dir + "'");
-    }
-    record_tof_ << "fire_stamp_ns,beacon_id,receiver_id,tof_s,beacon_temperature_c,sequence_number,"
-                   "true_beacon_id,echo\n"
-                << std::setprecision(12);
-    if (source_->beacon_input() == BeaconInput::kPulseArrivals) {
-      record_pulse_.open(options_.record_dir + "/pulse.csv");
-      if (!record_pulse_) throw std::runtime_error("cannot write pulse.csv in '" + options_.record_dir + "'");
-      record_pulse_ << "arrival_stamp_ns,receiver_id,mark,sequence_number,true_beacon_id,echo\n";
-    }
-    record_odometry_
-        << "stamp_ns,wheel_velocity_right_mps,wheel_velocity_left_mps,wheel_base_m,var_right,var_left\n"
-        << std::setprecision(12);
+    constexpr bool kWithHiddenTruth = true;
+    record_.emplace(options_.record_dir, kWithHiddenTruth);
+    record_->write_receivers(source_->receivers());
   }
   const double source_s = ns_to_s(source_->last_stamp_ns() - source_->first_stamp_ns());
   total_s_ = options_.duration_s > 0.0 ? options_.duration_s : source_s;
@@ -70,6 +62,7 @@ GatewayParticipant::GatewayParticipant(const dds::DdsOptions& dds, GatewayOption
     tof_writer_->assert_liveliness();
     pulse_writer_->assert_liveliness();
     odometry_writer_->assert_liveliness();
+    repeat_map_after_match();
   });
   if (!options_.firings_csv.empty()) {
     firings_.open(options_.firings_csv);
@@ -119,6 +112,23 @@ bool GatewayParticipant::wait_for_readers(std::chrono::milliseconds timeout) con
   return dds::wait_for_matched_readers({pulses ? pulse_writer_ : tof_writer_, odometry_writer_}, timeout);
 }
 
+bool GatewayParticipant::wait_for_readers_before_start() {
+  const bool pulses = source_->beacon_input() == BeaconInput::kPulseArrivals;
+  const auto matched = [](const dds::Writer& w) {
+    eprosima::fastdds::dds::PublicationMatchedStatus status;
+    w->get_publication_matched_status(status);
+    return status.current_count;
+  };
+  for (;;) {
+    if (matched(pulses ? pulse_writer_ : tof_writer_) >= options_.own_beacon_readers + options_.wait_for_readers &&
+        matched(odometry_writer_) >= options_.own_odometry_readers + options_.wait_for_readers) {
+      return true;
+    }
+    std::unique_lock<std::mutex> lock(stop_mutex_);
+    if (stop_cv_.wait_for(lock, std::chrono::milliseconds(10), [this] { return stop_.load(); })) return false;
+  }
+}
+
 void GatewayParticipant::start() {
   thread_ = std::thread([this] { run(); });
 }
@@ -136,12 +146,41 @@ void GatewayParticipant::rethrow_failure() const {
   if (!failure_.empty()) throw std::runtime_error(failure_);
 }
 
+void GatewayParticipant::repeat_map_after_match() {
+  if (!map_written_.load(std::memory_order_acquire)) return;
+  const StampNs match_ns = map_readers_.newest_match_ns.load();
+  if (match_ns == 0) return;
+  if (match_ns != map_repeat_match_ns_) {
+    map_repeat_match_ns_ = match_ns;
+    map_repeats_ = 0;
+  }
+  // Once a second for kMapRepeats seconds after the newest match.
+  if (map_repeats_ == kMapRepeats ||
+      dds::steady_clock_ns() - match_ns < static_cast<StampNs>(map_repeats_ + 1) * kNsPerSecond) {
+    return;
+  }
+  ++map_repeats_;
+  if (!map_writer_->write(&map_msg_)) count(false);  // the same map: not a new sample
+}
+
 void GatewayParticipant::count(bool written) {
   std::lock_guard<std::mutex> lock(counts_mutex_);
   if (written) {
     counts_.accept();
   } else {
     counts_.reject("write_failed");
+  }
+}
+
+template <class Write>
+void GatewayParticipant::record(Write&& write) {
+  if (!record_) return;
+  try {
+    write();
+  } catch (const std::runtime_error& e) {
+    // A full disk, say: the run goes on without its recording, and fails at the end saying why.
+    failure_ = e.what();
+    record_.reset();
   }
 }
 
@@ -158,12 +197,7 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
   switch (e.kind) {
     case SourceEvent::Kind::kTof: {
       e.tof.fire_stamp_ns += offset_ns;
-      if (record_tof_.is_open()) {
-        const auto& t = e.tof;
-        record_tof_ << t.fire_stamp_ns << ',' << t.beacon_id << ',' << t.receiver_id << ',' << t.tof_s << ','
-                    << t.beacon_temperature_c << ',' << t.sequence_number << ',' << e.true_beacon_id << ','
-                    << e.tof_is_echo << '\n';
-      }
+      record([&] { record_->write(e.tof, {e.true_beacon_id, e.tof_is_echo}); });
       auto m = dds::to_msg(options_.robot_id, e.tof);
       count(tof_writer_->write(&m));  // bool in Fast DDS 2.9 (TOOLCHAIN.md)
       ++progress_.tofs_written;
@@ -171,11 +205,7 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
     }
     case SourceEvent::Kind::kPulse: {
       e.pulse.stamp_ns = stamp;
-      if (record_pulse_.is_open()) {
-        const auto& p = e.pulse;
-        record_pulse_ << p.stamp_ns << ',' << p.receiver_id << ',' << to_string(p.mark) << ',' << p.sequence_number
-                      << ',' << e.true_beacon_id << ',' << e.tof_is_echo << '\n';
-      }
+      record([&] { record_->write(e.pulse, {e.true_beacon_id, e.tof_is_echo}); });
       auto m = dds::to_msg(options_.robot_id, e.pulse);
       count(pulse_writer_->write(&m));
       ++progress_.tofs_written;
@@ -183,13 +213,7 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
     }
     case SourceEvent::Kind::kOdometry: {
       e.odometry.stamp_ns = stamp;
-      if (record_odometry_.is_open()) {
-        const auto& o = e.odometry;
-        record_odometry_ << o.stamp_ns << ',' << o.wheel_velocity_right_mps << ','
-                         << o.wheel_velocity_left_mps << ',' << o.wheel_base_m << ','
-                         << o.wheel_velocity_covariance(0, 0) << ',' << o.wheel_velocity_covariance(1, 1)
-                         << '\n';
-      }
+      record([&] { record_->write(e.odometry); });
       auto m = dds::to_msg(options_.robot_id, e.odometry, odometry_sequence_++);
       count(odometry_writer_->write(&m));
       ++progress_.odometry_written;
@@ -197,6 +221,7 @@ void GatewayParticipant::publish(SourceEvent& e, StampNs offset_ns) {
     }
     case SourceEvent::Kind::kLaserScan: {
       e.scan.stamp_ns = stamp;
+      record([&] { record_->write(e.scan); });
       auto m = dds::to_msg(options_.robot_id, e.scan);
       count(scan_writer_->write(&m));
       break;
@@ -253,9 +278,14 @@ void GatewayParticipant::run() {
   // real times. A recording keeps its own clock.
   const StampNs offset_ns =
       source_->relative_stamps() && options_.wall_clock_stamps ? dds::wall_clock_ns() : 0;
-  auto beacon_map = dds::to_msg(source_->beacon_map(), options_.frame_id);
-  count(map_writer_->write(&beacon_map));
+  map_msg_ = dds::to_msg(source_->beacon_map(), options_.frame_id);
+  count(map_writer_->write(&map_msg_));
+  map_written_.store(true, std::memory_order_release);
   if (throttle_) throttle_();  // before the first sample: the map may be waited for
+  if (options_.wait_for_readers > 0 && !wait_for_readers_before_start()) {
+    finished_ = true;
+    return;
+  }
 
   std::vector<SourceEvent> events;
   const StampNs step_ns = 10 * kNsPerMillisecond;
@@ -285,7 +315,7 @@ void GatewayParticipant::run() {
     if (throttle_) throttle_();
     if (source_->exhausted()) break;
   }
-  for (auto* file : {&truth_, &record_tof_, &record_odometry_, &firings_}) {
+  for (auto* file : {&truth_, &firings_}) {
     if (file->is_open() && !file->flush()) failure_ = "writing the gateway's output files failed";
   }
   diagnostics_->publish_now();

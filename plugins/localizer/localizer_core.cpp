@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "beaconloc/core/estimator_registry.hpp"
+#include "beaconloc/core/filters/symmetric.hpp"
 
 namespace beaconloc {
 
@@ -179,6 +180,11 @@ std::optional<LocalizerOutput> LocalizerCore::output(const std::string& robot_id
     return std::nullopt;
   }
   estimate->status = r.status();
+  // An estimator's covariance is symmetric up to its own rounding (an odometry step's F P F^T, a
+  // correction carried forward): published exactly symmetric, as ROS 2 consumers take a
+  // covariance and a recording's reader checks it (a difference in the last bit, seen on
+  // range_ekf's poses).
+  estimate->covariance = symmetrized(estimate->covariance);
   LocalizerOutput out{robot_id, *estimate, {r.beacons_used.begin(), r.beacons_used.end()}, {}};
   r.beacons_used.clear();
   // Compared as a difference: a stamp near the clock's end must not overflow.

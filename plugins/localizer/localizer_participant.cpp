@@ -107,17 +107,20 @@ LocalizerParticipant::LocalizerParticipant(const dds::DdsOptions& dds, Localizer
       share_calibration();
     }
   };
-  readers_.push_back(participant_.subscribe_with_info<msg::BeaconMapPubSubType>(
-      dds::kBeaconMapTopic,
-      [this](const msg::BeaconMap& m, const eprosima::fastdds::dds::SampleInfo& info) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        if (core_.on_beacon_map(dds::from_msg(m))) {
-          map_sources_.on_map(dds::writer_id(info.publication_handle), core_.beacon_map());
-          map_frame_id_ = m.frame_id();
-          share_calibration();  // a new map drops the groups it does not hold
-        }
-      },
-      map_events));
+  map_reader_ = std::make_unique<dds::FirstSampleWatch>([this, map_events](std::function<void()> heard) {
+    return participant_.subscribe_with_info<msg::BeaconMapPubSubType>(
+        dds::kBeaconMapTopic,
+        [this, heard](const msg::BeaconMap& m, const eprosima::fastdds::dds::SampleInfo& info) {
+          heard();
+          std::lock_guard<std::mutex> lock(mutex_);
+          if (core_.on_beacon_map(dds::from_msg(m))) {
+            map_sources_.on_map(dds::writer_id(info.publication_handle), core_.beacon_map());
+            map_frame_id_ = m.frame_id();
+            share_calibration();  // a new map drops the groups it does not hold
+          }
+        },
+        map_events);
+  }, [this] { return odometry_processed_.load() + ranges_processed_.load() > 0; });  // a gateway heard
   // Other localizers' calibrations (its own comes back too: not news). Each sample is a site's
   // whole calibration; its groups replace the ones held (LocalizerCore::on_calibration).
   readers_.push_back(participant_.subscribe_with_info<msg::BeaconCalibrationPubSubType>(
@@ -569,6 +572,7 @@ msg::Diagnostics LocalizerParticipant::diagnostics_snapshot() {
   counts.reject("calibration_file.write_failed", calibration_saves_failed_);
   counts.reject("calibration.too_many_beacons", calibrations_refused_too_large_);
   counts.reject("calibration.other_frame", calibrations_refused_other_frame_);
+  counts.reject(dds::kMapReaderRecreated, map_reader_->recreated());
   for (const auto& [reason, n] : shard_announcements_refused_) counts.reject(reason, n);
   auto d = dds::make_diagnostics(participant_.name(), dds::wall_clock_ns(), counts, deadline_misses_.load(),
                                  status, message);

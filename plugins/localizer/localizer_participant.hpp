@@ -18,6 +18,7 @@
 
 #include "beaconloc/core/beacon_map_sources.hpp"
 #include "beaconloc/dds/diagnostics_publisher.hpp"
+#include "beaconloc/dds/first_sample_watch.hpp"
 #include "beaconloc/dds/participant.hpp"
 #include "localizer_core.hpp"
 #include "serving_conflicts.hpp"
@@ -172,6 +173,8 @@ class LocalizerParticipant {
   dds::Writer calibration_writer_;  // BeaconCalibration: the site's calibrated beacon groups
   dds::Writer plan_writer_;         // FiringPlan, with selective activation
   dds::Writer shard_writer_;        // LocalizerShard, with options_.shard
+  // Before diagnostics_, which reports its count: it goes after the Diagnostics task stops.
+  std::unique_ptr<dds::FirstSampleWatch> map_reader_;  // recreated when mute (first_sample_watch.hpp)
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;
   std::vector<dds::Reader> readers_;
   std::unique_ptr<dds::PeriodicTask> shard_liveliness_;  // asserts shard_writer_'s; stops first

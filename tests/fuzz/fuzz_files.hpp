@@ -56,4 +56,17 @@ inline void write_or_remove(const std::filesystem::path& file, const std::vector
   }
 }
 
+// The recording's files in scratch_dir(), one per part in the order of `names`: a part that is
+// empty or missing is an absent file (a recording of pulses has no ranges.csv).
+inline void write_recording(const std::vector<std::string>& parts, const std::vector<const char*>& names) {
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i < parts.size() && parts[i].empty()) {
+      std::error_code ignored;
+      std::filesystem::remove(scratch_dir() / names[i], ignored);
+    } else {
+      write_or_remove(scratch_dir() / names[i], parts, i);
+    }
+  }
+}
+
 }  // namespace beaconloc::fuzz

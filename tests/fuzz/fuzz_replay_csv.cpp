@@ -27,16 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace beaconloc;
   const auto parts = fuzz::split_parts(data, size);
   const auto& dir = fuzz::scratch_dir();
-  const char* files[] = {"beacons.csv", "odom.csv", "ranges.csv", "gt.csv", "pulses.csv"};
-  // An empty part is an absent file: a recording of pulses has no ranges.csv.
-  for (std::size_t i = 0; i < 5; ++i) {
-    if (i < parts.size() && parts[i].empty()) {
-      std::error_code ignored;
-      std::filesystem::remove(dir / files[i], ignored);
-    } else {
-      fuzz::write_or_remove(dir / files[i], parts, i);
-    }
-  }
+  fuzz::write_recording(parts, {"beacons.csv", "odom.csv", "ranges.csv", "gt.csv", "pulses.csv"});
   std::unique_ptr<ReplaySource> replay;
   try {
     replay = std::make_unique<ReplaySource>(dir.string());

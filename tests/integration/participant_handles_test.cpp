@@ -9,6 +9,7 @@
 #include <chrono>
 #include <thread>
 
+#include "beaconloc/dds/first_sample_watch.hpp"
 #include "beaconloc/dds/participant.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
 #include "participants_test.hpp"
@@ -79,6 +80,31 @@ TEST_F(ParticipantHandles, AHandleThatWouldOutliveItsParticipantAbortsNamingIt) 
         }
       },
       "participant 'test.outlived' destroyed before 1 of its readers or writers");
+}
+
+// A reader that must hear (the beacon map) and stays mute while matched (Fast DDS 2.9's secured
+// pair that never completes its key exchange; here, a writer that writes nothing) is recreated
+// after FirstSampleWatch::kMuteAfterNs, counted; once it has heard a sample it is left alone.
+TEST_F(ParticipantHandles, AMuteReaderOfTheBeaconMapIsRecreatedUntilItHears) {
+  dds::Participant bus(dds_, "test.first_sample");
+  dds::Writer writer = bus.writer<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic);
+  std::atomic<int> maps{0};
+  dds::FirstSampleWatch watch([&](std::function<void()> heard) {
+    return bus.subscribe<msg::BeaconMapPubSubType>(dds::kBeaconMapTopic, [&, heard](const msg::BeaconMap&) {
+      heard();
+      ++maps;
+    });
+  });
+  ASSERT_TRUE(dds::wait_for_matched_readers({writer}, scaled(10s)));
+  EXPECT_TRUE(eventually([&] { return watch.recreated() >= 1; }, scaled(15s))) << "a mute reader was kept";
+  ASSERT_TRUE(dds::wait_for_matched_readers({writer}, scaled(10s)));  // the new reader
+  msg::BeaconMap m;
+  m.frame_id("map");
+  ASSERT_TRUE(writer->write(&m));
+  ASSERT_TRUE(eventually([&] { return maps.load() >= 1; }, scaled(10s)));
+  const std::uint64_t after_hearing = watch.recreated();
+  std::this_thread::sleep_for(std::chrono::nanoseconds(2 * dds::FirstSampleWatch::kMuteAfterNs));
+  EXPECT_EQ(watch.recreated(), after_hearing) << "a reader that heard was recreated";
 }
 
 }  // namespace

@@ -9,7 +9,10 @@
 // know. Prints "cyclone peer: writers up" once its endpoints exist. Exit 0 once every topic has
 // delivered a correct sample; 1, with the failures on stderr, at the first wrong field or when
 // --seconds run out.
-//   cyclone_ros2_peer --domain N --seconds S --beacons ID:X:Y:Z[,ID:X:Y:Z...]
+//   cyclone_ros2_peer --domain N --seconds S --beacons ID:X:Y:Z[,ID:X:Y:Z...] [--keystore DIR --enclave E]
+// With --keystore, it joins with DDS Security as an SROS2 node does: the enclave's files of an
+// SROS2 keystore (scripts/deployment-keys.sh makes one) and Cyclone's security plugins
+// (CYCLONE_SECURITY_DIR: Debian ships them beside libddsc).
 #include <dds/dds.h>
 
 #include <chrono>
@@ -71,11 +74,14 @@ dds_qos_t* qos(bool reliable, bool transient_local, int depth) {
 int main(int argc, char** argv) {
   int domain = 0;
   double seconds = 30.0;
+  std::string keystore, enclave;
   std::vector<Beacon> beacons;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i], value = argv[i + 1];
     if (key == "--domain") domain = std::atoi(value.c_str());
     if (key == "--seconds") seconds = std::atof(value.c_str());
+    if (key == "--keystore") keystore = value;
+    if (key == "--enclave") enclave = value;
     if (key == "--beacons") {
       std::stringstream list(value);
       std::string item;
@@ -86,12 +92,31 @@ int main(int argc, char** argv) {
     }
   }
   // Loopback only, unicast discovery to 127.0.0.1 (ROS2-INTEROP.md: Cyclone on lo).
-  setenv("CYCLONEDDS_URI",
-         "<CycloneDDS><Domain><General><Interfaces><NetworkInterface name=\"lo\" multicast=\"false\"/>"
-         "</Interfaces></General><Discovery><Peers><Peer address=\"127.0.0.1\"/></Peers>"
-         "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>30</MaxAutoParticipantIndex>"
-         "</Discovery></Domain></CycloneDDS>",
-         1);
+  std::string config =
+      "<CycloneDDS><Domain><General><Interfaces><NetworkInterface name=\"lo\" multicast=\"false\"/>"
+      "</Interfaces></General><Discovery><Peers><Peer address=\"127.0.0.1\"/></Peers>"
+      "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>30</MaxAutoParticipantIndex>"
+      "</Discovery>";
+  if (!keystore.empty()) {
+    // The files rmw_cyclonedds takes from ROS_SECURITY_KEYSTORE/enclaves/ROS_SECURITY_ENCLAVE.
+    const std::string files = "file:" + keystore + "/enclaves" + enclave + "/";
+    const std::string plugins = CYCLONE_SECURITY_DIR "/libdds_security_";
+    config += "<Security><Authentication><Library path=\"" + plugins +
+              "auth.so\" initFunction=\"init_authentication\" finalizeFunction=\"finalize_authentication\"/>"
+              "<IdentityCertificate>" + files + "cert.pem</IdentityCertificate>"
+              "<IdentityCA>" + files + "identity_ca.cert.pem</IdentityCA>"
+              "<PrivateKey>" + files + "key.pem</PrivateKey></Authentication>"
+              "<AccessControl><Library path=\"" + plugins +
+              "ac.so\" initFunction=\"init_access_control\" finalizeFunction=\"finalize_access_control\"/>"
+              "<PermissionsCA>" + files + "permissions_ca.cert.pem</PermissionsCA>"
+              "<Governance>" + files + "governance.p7s</Governance>"
+              "<Permissions>" + files + "permissions.p7s</Permissions></AccessControl>"
+              "<Cryptographic><Library path=\"" + plugins +
+              "crypto.so\" initFunction=\"init_crypto\" finalizeFunction=\"finalize_crypto\"/>"
+              "</Cryptographic></Security>";
+  }
+  config += "</Domain></CycloneDDS>";
+  setenv("CYCLONEDDS_URI", config.c_str(), 1);
   const dds_entity_t participant =
       dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr);
   if (participant < 0) {

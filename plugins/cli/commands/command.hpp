@@ -35,5 +35,7 @@ void add_participant_commands(CLI::App& app, std::vector<std::unique_ptr<Command
 void add_pipeline_commands(CLI::App& app, std::vector<std::unique_ptr<Command>>& out);
 void add_offline_commands(CLI::App& app, std::vector<std::unique_ptr<Command>>& out);
 void add_monitor_command(CLI::App& app, std::vector<std::unique_ptr<Command>>& out);
+void add_record_command(CLI::App& app, std::vector<std::unique_ptr<Command>>& out);
+void add_serial_sim_command(CLI::App& app, std::vector<std::unique_ptr<Command>>& out);
 
 }  // namespace beaconloc::cli

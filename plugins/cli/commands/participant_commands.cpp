@@ -7,6 +7,7 @@
 #include "beaconloc/core/estimator_registry.hpp"
 #include "beaconloc/core/limits.hpp"
 #include "beaconloc/dds/stop_signal.hpp"
+#include "beaconloc/dds/wall_clock.hpp"
 #include "bridge_participant.hpp"
 #include "command.hpp"
 #include "decoder_participant.hpp"
@@ -14,6 +15,7 @@
 #include "monitor.hpp"
 #include "number_options.hpp"
 #include "options.hpp"
+#include "serial_source.hpp"
 
 namespace beaconloc::cli {
 namespace {
@@ -33,11 +35,43 @@ class GatewayCommand : public Command {
     const std::vector<CLI::Option*> source = source_option_set(source_).add_to(app_);
     source[0]->excludes(source[1]);  // --scenario or --replay
     gateway_option_set(gateway_, seed_).add_to(app_);
+    // Receiver hardware on a serial line (docs/serial-protocol.md): live, in real time.
+    CLI::Option* serial_device =
+        app_->add_option("--serial", serial_.device, "read receiver modules on this serial device (e.g. /dev/ttyUSB0)");
+    serial_device->excludes(source[0])->excludes(source[1]);
+    app_->add_option("--baud", serial_.baud, "the serial line's baud rate")->needs(serial_device);
+    app_->add_option("--serial-protocol", serial_protocol_, "beaconloc (our frames) or marvelmind (raw distances)")
+        ->check(CLI::IsMember({"beaconloc", "marvelmind"}))
+        ->needs(serial_device);
+    app_->add_option("--beacons", beacons_file_, "the site's beacons CSV (beacon_id,x_m,y_m,z_m): needed with --serial")
+        ->check(CLI::ExistingFile)
+        ->needs(serial_device);
+    app_->add_option("--temperature-c", serial_.temperature_c,
+                     "air temperature for TOFs that carry none (and Marvelmind distances' reference)")
+        ->transform(real_in(-100.0, 100.0))
+        ->needs(serial_device);
+    app_->add_option("--odometry-k-v", serial_.odometry_k_v_m,
+                     "odometry noise reported with the line's wheel speeds: sigma^2 = k_v |v| / dT per wheel")
+        ->transform(real_in(0.0, 1.0))
+        ->needs(serial_device);
   }
   int execute() override {
-    LoadedSource source = load_source(source_, seed_);
-    gateway_.seed = source.seed;
-    GatewayParticipant participant(dds_, gateway_, std::move(source.source));
+    std::unique_ptr<Source> source;
+    if (!serial_.device.empty()) {
+      if (beacons_file_.empty()) throw std::invalid_argument("--serial needs --beacons: the line does not carry the map");
+      if (given("--speed") && gateway_.speed != 1.0) {
+        throw std::invalid_argument("--serial is live: --speed must be 1");
+      }
+      serial_.protocol = serial_protocol_ == "marvelmind" ? serial::Protocol::kMarvelmind : serial::Protocol::kBeaconloc;
+      serial_.beacons = load_beacon_map_csv(beacons_file_);
+      gateway_.speed = 1.0;
+      source = std::make_unique<SerialSource>(serial_, [] { return dds::wall_clock_ns(); });
+    } else {
+      LoadedSource loaded = load_source(source_, seed_);
+      gateway_.seed = loaded.seed;
+      source = std::move(loaded.source);
+    }
+    GatewayParticipant participant(dds_, gateway_, std::move(source));
     participant.start();
     while (!participant.finished() && !dds::wait_for_stop(100ms)) {
     }
@@ -47,10 +81,14 @@ class GatewayCommand : public Command {
   }
 
  private:
+  bool given(const char* flag) const { return app_->count(flag) > 0; }
   dds::DdsOptions dds_;
   SourceChoice source_;
   GatewayOptions gateway_;
   std::optional<std::uint64_t> seed_;
+  SerialSourceOptions serial_;
+  std::string serial_protocol_ = "beaconloc";
+  std::string beacons_file_;
 };
 
 class DecoderCommand : public Command {

@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <stdexcept>
+#include <string>
 
 #include "command.hpp"
 #include "options.hpp"
@@ -24,6 +26,10 @@ class PipelineCommand : public Command {
   // Runs it, prints the participants' counts and the score; exit 1 when no pose came, or none at
   // a stamp the ground truth covers (where the source has truth).
   int run_and_score(PipelineOptions o, LoadedSource source, const char* name) const {
+    if (!o.dds.security.enclave.empty()) {
+      throw std::invalid_argument(std::string("--enclave names one participant's identity: ") + name +
+                                  " starts several, each with its role's (dds::default_enclave)");
+    }
     std::cout << "beaconloc " << name << ": " << source.label << ", estimator " << o.localizer.estimator << ", seed "
               << source.seed << '\n';
     const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe");

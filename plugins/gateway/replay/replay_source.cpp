@@ -11,6 +11,7 @@
 #include "beaconloc/core/limits.hpp"
 #include "beaconloc/core/models/diff_drive_motion.hpp"
 #include "beaconloc/core/speed_of_sound.hpp"
+#include "bus_recording.hpp"
 
 namespace beaconloc {
 namespace {
@@ -70,6 +71,23 @@ ReplaySource::ReplaySource(const std::string& directory, ReplayOptions options)
     throw ReplayError("replay heading angle random walk must be in [0, " +
                       std::to_string(ReplayOptions::kMaxHeadingArwRadPerSqrtS) + "] rad/sqrt(s)");
   load_beacons(directory + "/beacons.csv");
+  const bool bus = static_cast<bool>(std::ifstream(directory + "/" + bus_recording::kOdometryFile));
+  if (bus && std::ifstream(directory + "/odom.csv")) {
+    throw ReplayError(directory + ": both odom.csv (a dataset) and odometry.csv (a recording of the bus)");
+  }
+  if (bus) {
+    load_bus_recording();
+  } else {
+    load_dataset();
+  }
+  // Merge the files by stamp; within a file, order is kept (stable).
+  std::stable_sort(events_.begin(), events_.end(),
+                   [](const SourceEvent& a, const SourceEvent& b) { return a.stamp_ns < b.stamp_ns; });
+  if (events_.empty()) throw ReplayError(directory + ": no odometry, range or truth rows");
+}
+
+void ReplaySource::load_dataset() {
+  const std::string& directory = directory_;
   load_odometry(directory + "/odom.csv");
   // A recording hears its beacons one way: ranges, or pulse arrivals without a firing time.
   const bool has_pulses = static_cast<bool>(std::ifstream(directory + "/pulses.csv"));
@@ -82,13 +100,9 @@ ReplaySource::ReplaySource(const std::string& directory, ReplayOptions options)
     load_ranges(directory + "/ranges.csv");
   }
   load_truth(directory + "/gt.csv");
-  // Merge the files by stamp; within a file, order is kept (stable).
-  std::stable_sort(events_.begin(), events_.end(),
-                   [](const SourceEvent& a, const SourceEvent& b) { return a.stamp_ns < b.stamp_ns; });
-  if (events_.empty()) throw ReplayError(directory + ": no odometry, range or truth rows");
 }
 
-ReceiverArray ReplaySource::receivers() const {
+ReceiverArray ReplaySource::single_receiver() {
   ReceiverArray a;  // one receiver (radio, UWB tag) at the robot's centre
   a.receivers_base_m.push_back(Eigen::Vector2d::Zero());
   return a;

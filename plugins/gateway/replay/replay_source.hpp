@@ -11,6 +11,9 @@
 // odometry interval or truth row at a stamp), "<file>.out_of_order_row". A missing file or header is
 // an error.
 // Ranges filed out of stamp order are replayed in stamp order (and said in load_notes()).
+// A directory holding odometry.csv is instead a recording of the bus (bus_recording.hpp): the
+// samples are replayed as they were published, numbers and all, for the decoder and the
+// localizer to judge again.
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -57,7 +60,7 @@ class ReplaySource final : public Source {
   bool exhausted() const override { return next_ >= events_.size(); }
   bool finite() const override { return true; }
   BeaconMap beacon_map() const override { return map_; }
-  ReceiverArray receivers() const override;
+  ReceiverArray receivers() const override { return receivers_; }
   StampNs first_stamp_ns() const override { return events_.empty() ? 0 : events_.front().stamp_ns; }
   StampNs last_stamp_ns() const override { return events_.empty() ? 0 : events_.back().stamp_ns; }
   bool relative_stamps() const override { return false; }
@@ -76,6 +79,8 @@ class ReplaySource final : public Source {
 
  private:
   void load_beacons(const std::string& path);
+  // A dataset (odom.csv, ranges.csv or pulses.csv, gt.csv): rows of (v, omega), ranges, pulses.
+  void load_dataset();
   void load_odometry(const std::string& path);
   // The wheel speeds' covariance reported with a row of (v, omega) held over dt_s, its wheels
   // half_track_m from the middle (ReplayOptions: the noise models).
@@ -84,6 +89,17 @@ class ReplaySource final : public Source {
   void load_ranges(const std::string& path);
   void load_pulses(const std::string& path);
   void load_truth(const std::string& path);
+  // A recording of the bus (bus_recording.hpp; replay_bus_recording.cpp): the samples as published.
+  void load_bus_recording();
+  void load_bus_odometry(const std::string& path);
+  void load_bus_tofs(const std::string& path);
+  void load_bus_pulses(const std::string& path);
+  void load_bus_scans(const std::string& path);
+  void load_bus_truth(const std::string& path);
+  void load_receivers(const std::string& path);
+  // The current row's integer `column` within [min, max]; else refused like take().
+  bool take_integer(const CsvReader& csv, const std::string& file, const std::string& column, std::int64_t& out,
+                    std::int64_t min, std::int64_t max);
   static CsvReader open(const std::string& path, const std::vector<std::string>& columns);
   // The current row has every cell; else refused as <file>.malformed_row.
   bool complete(const CsvReader& csv, const std::string& file);
@@ -99,6 +115,8 @@ class ReplaySource final : public Source {
   std::string directory_;
   ReplayOptions options_;
   BeaconMap map_;
+  ReceiverArray receivers_ = single_receiver();
+  static ReceiverArray single_receiver();
   std::vector<SourceEvent> events_;
   std::size_t next_ = 0;
   bool truth_has_yaw_ = false;

@@ -1,5 +1,8 @@
 #include "beaconloc/core/csv_reader.hpp"
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iomanip>
 #include <limits>
 #include <set>
@@ -126,19 +129,33 @@ BeaconMap load_beacon_map_csv(const std::string& path) {
   return BeaconMap(beacons);
 }
 
+void write_file_atomically(const std::string& path, const std::string& text) {
+  // Written beside it, then renamed over it: a reader, or a kill, sees the old file or the new.
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::trunc);
+    if (!out) throw CsvError("cannot write '" + temporary + "'");
+    if (!(out << text).flush()) throw CsvError("writing '" + temporary + "' failed");
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    throw CsvError("cannot rename '" + temporary + "' to '" + path + "': " + std::strerror(errno));
+  }
+}
+
 void write_beacon_map_csv(const std::string& path, const BeaconMap& map) {
-  std::ofstream out(path);
-  if (!out) throw CsvError("cannot write '" + path + "'");
-  out << "beacon_id,x_m,y_m,z_m,group,frame\n" << std::setprecision(10);
-  for (const auto& b : map.beacons()) {
-    out << b.id << ',' << b.position_map_m.x() << ',' << b.position_map_m.y() << ',' << b.position_map_m.z() << ','
-        << b.group << ",map\n";
-  }
-  for (const auto& b : map.local_beacons()) {
-    out << b.id << ',' << b.position_group_m.x() << ',' << b.position_group_m.y() << ','
-        << b.position_group_m.z() << ',' << b.group << ",group\n";
-  }
-  if (!out.flush()) throw CsvError("writing '" + path + "' failed");
+  // Positions as the shortest text that reads back to the same double: a map read again is the map.
+  std::string text = "beacon_id,x_m,y_m,z_m,group,frame\n";
+  const auto row = [&text](std::uint32_t id, const Eigen::Vector3d& p, std::uint32_t group, const char* frame) {
+    text += std::to_string(id);
+    for (int i = 0; i < 3; ++i) {
+      text += ',';
+      append_decimal(text, p(i));
+    }
+    text += ',' + std::to_string(group) + ',' + frame + '\n';
+  };
+  for (const auto& b : map.beacons()) row(b.id, b.position_map_m, b.group, "map");
+  for (const auto& b : map.local_beacons()) row(b.id, b.position_group_m, b.group, "group");
+  write_file_atomically(path, text);
 }
 
 }  // namespace beaconloc

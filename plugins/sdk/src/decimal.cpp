@@ -99,4 +99,10 @@ double decimal_or_throw(std::string_view text, const std::string& what) {
   return v;
 }
 
+void append_decimal(std::string& out, double value) {
+  char buffer[32];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);  // shortest round trip
+  out.append(buffer, end);
+}
+
 }  // namespace beaconloc

@@ -16,13 +16,19 @@ void DiagnosticsPublisher::publish_now() {
   // (a localizer shard's change) never cross, an older report written last.
   std::lock_guard<std::mutex> lock(publish_mutex_);
   msg::Diagnostics d = snapshot_();
-  // Samples no type support could read (Fast DDS dropped them), whatever the participant.
-  if (const std::uint64_t undecodable = participant_.undecodable_samples()) {
+  const auto add = [&d](const char* reason, std::uint64_t count) {
+    if (count == 0) return;
     msg::RejectionCount rc;
-    rc.reason("undecodable_sample");
-    rc.count(undecodable);
+    rc.reason(reason);
+    rc.count(count);
     d.rejected().push_back(rc);
-  }
+  };
+  // Samples no type support could read (Fast DDS dropped them), whatever the participant.
+  add("undecodable_sample", participant_.undecodable_samples());
+  // Samples of a robot's measurements from a writer that may not speak for that robot.
+  add("sample_for_another_robot", participant_.samples_for_another_robot());
+  // Secured messages whose authentication tag failed (tampered), counted for the whole process.
+  if (participant_.secured()) add("undecodable_secure_message", undecodable_secure_messages());
   writer_->write(&d);
 }
 

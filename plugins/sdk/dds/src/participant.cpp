@@ -2,6 +2,8 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
+#include <ctime>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <filesystem>
 #include <fstream>
@@ -72,6 +74,60 @@ bool wait_for_matched_readers(const std::vector<DataWriter*>& writers, std::chro
   }
 }
 
+void WriterRobots::on_publisher_discovery(DomainParticipant*, eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) {
+  using Status = eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERY_STATUS;
+  const InstanceHandle_t writer(info.info.guid());
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (info.status == Status::REMOVED_WRITER) {
+    // Kept a while: samples it wrote may still wait in a reader's queue.
+    retired_.push_back(writer);
+    if (retired_.size() > kRetiredWriters) {
+      robots_.erase(retired_.front());
+      retired_.pop_front();
+    }
+    return;
+  }
+  const std::string prefix = robot_partition("");
+  Entry seen;
+  for (const std::string& partition : info.info.m_qos.m_partition.getNames()) {
+    if (partition.rfind(prefix, 0) != 0) continue;
+    seen.partitioned = true;
+    seen.robots.push_back(partition.substr(prefix.size()));
+  }
+  const auto it = robots_.find(writer);
+  if (info.status == Status::CHANGED_QOS_WRITER && it == robots_.end()) {
+    robots_.emplace(writer, Entry{true, {}});  // a change of a writer forgotten: believed for no robot
+    return;
+  }
+  if (info.status == Status::CHANGED_QOS_WRITER) {
+    // Only ever narrowed: Fast DDS 2.9 tells a writer's new partitions before access control
+    // judges them, and keeps the match when it refuses them, so a writer that moved to another
+    // robot's partition must not be believed.
+    std::vector<std::string> kept;
+    for (const std::string& robot : it->second.robots) {
+      if (std::find(seen.robots.begin(), seen.robots.end(), robot) != seen.robots.end()) kept.push_back(robot);
+    }
+    it->second.robots = std::move(kept);
+    return;
+  }
+  if (it == robots_.end()) robots_.emplace(writer, std::move(seen));
+}
+
+void WriterRobots::add(const InstanceHandle_t& writer, std::vector<std::string> robots) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Entry e;
+  e.partitioned = !robots.empty();
+  e.robots = std::move(robots);
+  robots_[writer] = std::move(e);
+}
+
+bool WriterRobots::may_speak_for(const InstanceHandle_t& writer, const std::string& robot_id, bool strict) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = robots_.find(writer);
+  if (it == robots_.end() || !it->second.partitioned) return !strict;
+  return std::find(it->second.robots.begin(), it->second.robots.end(), robot_id) != it->second.robots.end();
+}
+
 Participant::Participant(const DdsOptions& options, const std::string& name) : name_(name) {
   if (options.domain_id < 0 || options.domain_id > 232) {
     throw DdsError("domain id " + std::to_string(options.domain_id) + " is outside 0..232");
@@ -84,11 +140,56 @@ Participant::Participant(const DdsOptions& options, const std::string& name) : n
     throw DdsError("participant profile '" + options.participant_profile + "' is not defined");
   }
   qos.name(name);
-  participant_ = factory->create_participant(options.domain_id, qos);
-  if (!participant_) throw DdsError("cannot create participant '" + name + "'");
+  if (options.transport) {
+    qos.transport().use_builtin_transports = false;
+    qos.transport().user_transports = {options.transport};
+  }
+  std::string enclave;
+  if (options.security.enabled()) {
+    if (options.domain_id > kMaxSecuredDomainId) {
+      throw SecurityError("domain " + std::to_string(options.domain_id) + ": a secured deployment's governance "
+                          "covers domains 0.." + std::to_string(kMaxSecuredDomainId) + " (scripts/deployment-keys.sh)");
+    }
+    enclave = options.security.enclave.empty() ? default_enclave(name) : options.security.enclave;
+    enable_security(check_enclave(options.security, enclave, static_cast<std::int64_t>(std::time(nullptr))), qos);
+    secured_ = true;
+  }
+  // Only the discovery of publishers is listened to (WriterRobots): the entities' statuses go to
+  // their own listeners.
+  participant_ = factory->create_participant(options.domain_id, qos, &writer_robots_, StatusMask::none());
+  if (!participant_) {
+    if (secured_) {
+      throw SecurityError("cannot create participant '" + name + "' as enclave " + enclave + " of keystore '" +
+                          options.security.keystore +
+                          "': Fast DDS refused its security (its log above may say why; the files passed "
+                          "beaconloc's own checks)");
+    }
+    throw DdsError("cannot create participant '" + name + "'");
+  }
   publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
-  if (!publisher_ || !subscriber_) throw DdsError("cannot create publisher/subscriber");
+  SubscriberQos robot_qos = SUBSCRIBER_QOS_DEFAULT;
+  robot_qos.partition().push_back((robot_partition("") + "*").c_str());
+  if (!secured_) robot_qos.partition().push_back("");  // a tool's writer of many robots
+  robot_subscriber_ = participant_->create_subscriber(robot_qos);
+  if (!publisher_ || !subscriber_ || !robot_subscriber_) {
+    // No destructor runs for a constructor that throws: the participant goes here, before the
+    // listener it holds (writer_robots_) does.
+    participant_->delete_contained_entities();
+    factory->delete_participant(participant_);
+    throw DdsError("cannot create publisher/subscriber");
+  }
+}
+
+Publisher* Participant::robot_publisher(const std::string& robot_id) {
+  auto it = robot_publishers_.find(robot_id);
+  if (it != robot_publishers_.end()) return it->second;
+  PublisherQos qos = PUBLISHER_QOS_DEFAULT;
+  qos.partition().push_back(robot_partition(robot_id).c_str());
+  Publisher* p = participant_->create_publisher(qos);
+  if (!p) throw DdsError("cannot create the publisher of robot '" + robot_id + "'");
+  robot_publishers_[robot_id] = p;
+  return p;
 }
 
 Participant::~Participant() {
@@ -121,18 +222,33 @@ Topic* Participant::topic(const std::string& name, TopicDataType* type) {
   return t;
 }
 
-Writer Participant::make_writer(Topic* topic, const std::string& profile, DataWriterListener* listener) {
-  DataWriter* w = publisher_->create_datawriter_with_profile(topic, profile, listener);
-  if (!w) throw DdsError("cannot create writer on " + topic->get_name() + " with profile " + profile);
-  return Writer(publisher_, w, nullptr, &live_handles_);
+Writer Participant::make_writer(const TopicSpec& spec, Topic* topic, DataWriterListener* listener,
+                                const std::string* robot_id) {
+  Publisher* publisher = robot_id ? robot_publisher(*robot_id) : publisher_;
+  DataWriter* w = publisher->create_datawriter_with_profile(topic, spec.writer_profile, listener);
+  if (!w) {
+    throw DdsError("cannot create writer on " + topic->get_name() + " with profile " + spec.writer_profile +
+                   (robot_id ? " in partition " + robot_partition(*robot_id) : std::string()) +
+                   (secured_ ? " (is it granted by this enclave's permissions?)" : ""));
+  }
+  // This participant's own samples reach its readers without discovery.
+  if (spec.per_robot) {
+    writer_robots_.add(w->get_instance_handle(),
+                       robot_id ? std::vector<std::string>{*robot_id} : std::vector<std::string>{});
+  }
+  return Writer(publisher, w, nullptr, &live_handles_);
 }
 
-Reader Participant::make_reader(Topic* topic, const std::string& profile, std::unique_ptr<DataReaderListener> owned,
+Reader Participant::make_reader(const TopicSpec& spec, Topic* topic, std::unique_ptr<DataReaderListener> owned,
                                 DataReaderListener* borrowed) {
   DataReaderListener* listener = owned ? owned.get() : borrowed;
-  DataReader* r = subscriber_->create_datareader_with_profile(topic, profile, listener);
-  if (!r) throw DdsError("cannot create reader on " + topic->get_name() + " with profile " + profile);
-  return Reader(subscriber_, r, std::move(owned), &live_handles_);
+  Subscriber* subscriber = spec.per_robot ? robot_subscriber_ : subscriber_;
+  DataReader* r = subscriber->create_datareader_with_profile(topic, spec.reader_profile, listener);
+  if (!r) {
+    throw DdsError("cannot create reader on " + topic->get_name() + " with profile " + spec.reader_profile +
+                   (secured_ ? " (is it granted by this enclave's permissions?)" : ""));
+  }
+  return Reader(subscriber, r, std::move(owned), &live_handles_);
 }
 
 }  // namespace beaconloc::dds

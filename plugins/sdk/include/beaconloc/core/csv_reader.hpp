@@ -66,6 +66,9 @@ std::vector<std::string> split_csv_line(const std::string& line);
 // lie within kMaxMapCoordinateM, core/limits.hpp), a repeated id, a frame neither map nor group,
 // a local beacon without a group, a group of both kinds, or a file without beacons.
 BeaconMap load_beacon_map_csv(const std::string& path);
+// Written whole or not at all (a temporary file renamed over it): a kill never leaves half a map.
 void write_beacon_map_csv(const std::string& path, const BeaconMap& map);
+// text into path, through a temporary file beside it renamed over it. Throws CsvError.
+void write_file_atomically(const std::string& path, const std::string& text);
 
 }  // namespace beaconloc

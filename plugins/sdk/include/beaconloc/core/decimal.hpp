@@ -29,6 +29,11 @@ std::string number_problem(const std::string& what, std::string_view text, Numbe
 // "<what> <value> is outside [min, max]": a number that parsed but lies beyond its field's range.
 std::string range_problem(const std::string& what, double value, double min, double max);
 
+// Appends the shortest decimal text that parse_decimal reads back to exactly this finite double
+// (std::to_chars; it may use an exponent, "1e-07"): files the project writes to be read again
+// (beacon maps, recordings of the bus) lose nothing.
+void append_decimal(std::string& out, double value);
+
 // The value of text, or std::invalid_argument(number_problem(what, text, ...)).
 double decimal_or_throw(std::string_view text, const std::string& what);
 

@@ -6,7 +6,9 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
@@ -16,6 +18,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/transport/TransportDescriptorInterface.h>
 #include <functional>
 #include <initializer_list>
 #include <map>
@@ -25,13 +28,16 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "beaconloc/core/deadline_watch.hpp"
 #include "beaconloc/core/participant_id.hpp"
 #include "beaconloc/dds/checked_type.hpp"
+#include "beaconloc/dds/raw_cdr_type.hpp"
 #include "beaconloc/dds/periodic_task.hpp"
+#include "beaconloc/dds/security.hpp"
 #include "beaconloc/dds/topics.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
 
@@ -42,6 +48,9 @@ struct DdsOptions {
   // The loopback-only profile keeps every packet on the machine (examples/qos/loopback.xml).
   std::string participant_profile = "beaconloc.loopback";
   std::vector<std::string> extra_qos_files;  // loaded after the embedded profiles
+  SecurityOptions security;                   // off unless a keystore is given
+  // A transport of the caller's in place of the profile's (a test's transport that tampers).
+  std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface> transport;
 };
 
 class DdsError : public std::runtime_error {
@@ -90,6 +99,42 @@ inline std::string writer_id(const eprosima::fastdds::dds::InstanceHandle_t& pub
 }
 
 using beaconloc::participant_of_writer;  // core/participant_id.hpp
+
+// The partition a robot's measurements travel in (TopicSpec::per_robot): a gateway's permissions
+// grant it its own robot's partition only (scripts/deployment-keys.sh).
+inline std::string robot_partition(const std::string& robot_id) { return "robot/" + robot_id; }
+
+template <class Msg, class = void>
+struct HasRobotId : std::false_type {};
+template <class Msg>
+struct HasRobotId<Msg, std::void_t<decltype(std::declval<const Msg&>().robot_id())>> : std::true_type {};
+
+// Which robots each writer of a per-robot topic may speak for: the robots of its partitions, as
+// discovery (authenticated and access-checked when secured) told them when it found the writer,
+// and this participant's own writers. Told of a remote writer before it is matched (Fast DDS calls
+// on_publisher_discovery before pairing), so no sample arrives from a writer it does not know. A
+// writer's later change of partitions only narrows its robots; a writer gone is forgotten once
+// kRetiredWriters more have gone (its last samples may still be queued).
+class WriterRobots : public eprosima::fastdds::dds::DomainParticipantListener {
+ public:
+  void on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                              eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override;
+  void add(const eprosima::fastdds::dds::InstanceHandle_t& writer, std::vector<std::string> robots);
+  // Whether the writer may publish samples of robot_id: it is in that robot's partition; or, only
+  // when unsecured (strict false), it is in no robot partition or not known.
+  bool may_speak_for(const eprosima::fastdds::dds::InstanceHandle_t& writer, const std::string& robot_id,
+                     bool strict) const;
+
+ private:
+  static constexpr std::size_t kRetiredWriters = 1024;
+  struct Entry {
+    bool partitioned = false;         // in a robot partition when found
+    std::vector<std::string> robots;  // those partitions' robots, narrowed by later changes
+  };
+  mutable std::mutex mutex_;
+  std::map<eprosima::fastdds::dds::InstanceHandle_t, Entry> robots_;
+  std::deque<eprosima::fastdds::dds::InstanceHandle_t> retired_;  // gone, oldest first
+};
 
 // Takes every valid sample a reader has and hands it to a callback with its SampleInfo; keeps
 // the topic's deadline per instance (TopicSpec::deadline_ns: a DeadlineWatch checked on a thread
@@ -259,10 +304,17 @@ class Participant {
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
 
+  // A writer in the default partition. Of a per-robot topic, only unsecured participants read it
+  // (a tool or benchmark writing many robots): a robot's own writer is robot_writer.
   template <class PubSubType>
   [[nodiscard]] Writer writer(const TopicSpec& spec, eprosima::fastdds::dds::DataWriterListener* listener = nullptr) {
-    return make_writer(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.writer_profile,
-                       listener);
+    return make_writer(spec, topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), listener, nullptr);
+  }
+  // A writer of one robot's samples of a per-robot topic, in that robot's partition.
+  template <class PubSubType>
+  [[nodiscard]] Writer robot_writer(const TopicSpec& spec, const std::string& robot_id) {
+    if (!spec.per_robot) throw std::logic_error(std::string("topic ") + spec.name + " is not per robot");
+    return make_writer(spec, topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), nullptr, &robot_id);
   }
   // Subscribes with the topic's reader profile; on_sample runs on the reader's thread for each
   // valid sample, until the handle goes (which owns the listener).
@@ -283,40 +335,80 @@ class Participant {
         std::move(events));
   }
   // The same, with each sample's SampleInfo (its writer: publication_handle).
+  // A per-robot topic's sample is taken only from a writer that may speak for its robot
+  // (WriterRobots); the others are counted (samples_for_another_robot) and dropped.
   template <class PubSubType>
   [[nodiscard]] Reader subscribe_with_info(const TopicSpec& spec,
                                            typename SampleListener<typename PubSubType::type>::OnSample on_sample,
                                            ReaderEvents<typename PubSubType::type> events = {}) {
-    return make_reader(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.reader_profile,
-                       std::make_unique<SampleListener<typename PubSubType::type>>(
-                           std::move(on_sample), std::move(events), spec.deadline_ns),
+    using Msg = typename PubSubType::type;
+    if constexpr (HasRobotId<Msg>::value) {
+      if (spec.per_robot) {
+        on_sample = [this, inner = std::move(on_sample)](const Msg& m,
+                                                          const eprosima::fastdds::dds::SampleInfo& info) {
+          if (!writer_robots_.may_speak_for(info.publication_handle, m.robot_id(), secured_)) {
+            ++samples_for_another_robot_;
+            return;
+          }
+          inner(m, info);
+        };
+      }
+    } else if (spec.per_robot) {
+      throw std::logic_error(std::string("per-robot topic ") + spec.name + " of a type without robot_id");
+    }
+    return make_reader(spec, topic(spec.name, new CheckedType<PubSubType>(&undecodable_)),
+                       std::make_unique<SampleListener<Msg>>(std::move(on_sample), std::move(events),
+                                                             spec.deadline_ns),
+                       nullptr);
+  }
+  // Each sample read and as the bytes it travelled in (raw_cdr_type.hpp): a recorder's reader of a
+  // topic that is not per robot (the ROS 2 ones).
+  template <class PubSubType>
+  [[nodiscard]] Reader subscribe_raw(const TopicSpec& spec,
+                                     typename SampleListener<RawSample<PubSubType>>::OnSample on_sample) {
+    if (spec.per_robot) throw std::logic_error(std::string("per-robot topic ") + spec.name + " needs subscribe");
+    return make_reader(spec, topic(spec.name, new RawCdrType<PubSubType>(&undecodable_)),
+                       std::make_unique<SampleListener<RawSample<PubSubType>>>(
+                           std::move(on_sample), ReaderEvents<RawSample<PubSubType>>{}, spec.deadline_ns),
                        nullptr);
   }
   // A reader with a listener of the caller's, which must outlive the handle (declared before it).
   // The topic's deadline (spec.deadline_ns) is the listener's to keep: this keeps none.
+  // Not for a per-robot topic (std::logic_error): its samples' robots are checked by subscribe.
   template <class PubSubType>
   [[nodiscard]] Reader reader(const TopicSpec& spec, eprosima::fastdds::dds::DataReaderListener* listener) {
-    return make_reader(topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), spec.reader_profile,
-                       nullptr, listener);
+    if (spec.per_robot) throw std::logic_error(std::string("per-robot topic ") + spec.name + " needs subscribe");
+    return make_reader(spec, topic(spec.name, new CheckedType<PubSubType>(&undecodable_)), nullptr, listener);
   }
   const std::string& name() const { return name_; }
   // Samples whose payload could not be read, on any topic (Fast DDS dropped them).
   std::uint64_t undecodable_samples() const { return undecodable_.load(); }
+  // Samples of a per-robot topic from a writer that may not speak for their robot (dropped).
+  std::uint64_t samples_for_another_robot() const { return samples_for_another_robot_.load(); }
+  bool secured() const { return secured_; }
 
  private:
   eprosima::fastdds::dds::Topic* topic(const std::string& name, eprosima::fastdds::dds::TopicDataType* type);
-  Writer make_writer(eprosima::fastdds::dds::Topic* topic, const std::string& profile,
-                     eprosima::fastdds::dds::DataWriterListener* l);
+  // robot_id: the robot whose partition the writer is in; null: the default partition.
+  Writer make_writer(const TopicSpec& spec, eprosima::fastdds::dds::Topic* topic,
+                     eprosima::fastdds::dds::DataWriterListener* l, const std::string* robot_id);
   // owned: the listener the handle keeps; else borrowed, the caller's.
-  Reader make_reader(eprosima::fastdds::dds::Topic* topic, const std::string& profile,
+  Reader make_reader(const TopicSpec& spec, eprosima::fastdds::dds::Topic* topic,
                      std::unique_ptr<eprosima::fastdds::dds::DataReaderListener> owned,
                      eprosima::fastdds::dds::DataReaderListener* borrowed);
+  eprosima::fastdds::dds::Publisher* robot_publisher(const std::string& robot_id);
 
   std::string name_;
+  bool secured_ = false;
   std::atomic<std::uint64_t> undecodable_{0};  // counted by the types this participant registers
+  std::atomic<std::uint64_t> samples_for_another_robot_{0};
+  WriterRobots writer_robots_;  // before the participant: its listener
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  // The readers of per-robot topics: every robot's partition, and (unsecured only) the default one.
+  eprosima::fastdds::dds::Subscriber* robot_subscriber_ = nullptr;
+  std::map<std::string, eprosima::fastdds::dds::Publisher*> robot_publishers_;  // by robot id
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
   std::atomic<int> live_handles_{0};  // Writers and Readers not yet reset
 };
