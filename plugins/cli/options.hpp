@@ -18,7 +18,7 @@ OptionSet gateway_option_set(GatewayOptions& o, std::optional<std::uint64_t>& se
 // --min-range-m, --max-range-m, --range-sigma-m, --range-scale, --max-age-ms (max_age_ns is set
 // from max_age_ms after parsing: decoder_config_with_age)
 OptionSet decoder_option_set(TofDecoderConfig& o, double& max_age_ms);
-// --estimator, --receivers, --param, --map, --initial-pose; standalone (the localizer command,
+// --estimator, --estimator-plugin, --receivers, --param, --map, --initial-pose; standalone (the localizer command,
 // not demo or run, whose source gives the receivers and names the robot): also --robot,
 // --receiver-radius-m, --receiver-count, --receiver-height-m.
 OptionSet localizer_option_set(LocalizerSettings& o, bool standalone);
