@@ -21,7 +21,14 @@
 #    full runs, not asserted.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Each step's wall-clock time, printed as it ends: CI must stay within 45 minutes (README.md).
+phase_start=$SECONDS
+phase() {
+  echo "test.sh: $1 took $((SECONDS - phase_start)) s (total $SECONDS s)"
+  phase_start=$SECONDS
+}
 bash scripts/build.sh Asan
+phase "the sanitized build"
 (
   set -a
   . scripts/sanitizers.env
@@ -30,10 +37,15 @@ bash scripts/build.sh Asan
     -E '^integration\.(Run\.ReplaysTheSharedRecordings|Qos\..*|StagedInstall)$' \
     -j 2 --output-on-failure
 )
+phase "the sanitized tests"
 bash scripts/build.sh Release
+phase "the Release build"
 ctest --test-dir build/release -j 2 --output-on-failure
+phase "the Release tests"
 # 3. build/fuzz: the libFuzzer targets (clang), each run for 10 s from its seed corpus: a short,
 #    bounded smoke run in CI; docs/fuzzing.md has the long runs.
 bash scripts/fuzz.sh --seconds 10
+phase "the fuzzers"
 # 4. Every benchmark, briefly, into build/bench-quick (figures not checked).
 bash scripts/bench.sh --quick --out build/bench-quick
+phase "the benchmarks"

@@ -80,14 +80,20 @@ OptionSet decoder_option_set(TofDecoderConfig& o, double& max_age_ms) {
   return set;
 }
 
+OptionSet estimator_plugin_option_set(std::vector<std::string>& plugins) {
+  OptionSet set;
+  set.texts("--estimator-plugin", plugins,
+            "load estimators built out of tree from this plugin file, or every *.so of this directory "
+            "(repeatable; docs/deployment.md)",
+            [](CLI::Option* option) { option->check(CLI::ExistingPath); });
+  return set;
+}
+
 OptionSet localizer_option_set(LocalizerSettings& o, bool standalone) {
   OptionSet set;
   set.text("--estimator", o.estimator, "estimator plugin (see beaconloc localizer --list-estimators)", {},
            OptionSet::Written::kAlways)
-      .texts("--estimator-plugin", o.estimator_plugins,
-             "load estimators built out of tree from this plugin file, or every *.so of this directory "
-             "(repeatable; docs/deployment.md)",
-             [](CLI::Option* option) { option->check(CLI::ExistingPath); })
+      .options_of(estimator_plugin_option_set(o.estimator_plugins))
       .text("--receivers", o.receivers, "receivers in the robot frame, x:y[,x:y...] (m)")
       .texts("--param", o.parameters, "estimator parameter NAME=VALUE (repeatable)")
       .text("--map", o.map_file,
