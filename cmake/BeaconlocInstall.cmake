@@ -11,7 +11,10 @@ set(BEACONLOC_PLUGIN_INSTALL_DIR ${CMAKE_INSTALL_LIBDIR}/beaconloc/estimators)
 install(TARGETS beaconloc RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 # The profiles are embedded in the executable; these copies are its reference, to read and to
 # edit into a file given with --qos.
-install(FILES examples/qos/loopback.xml examples/qos/topics.xml examples/qos/ros2_topics.xml
+# The profiles that reach other hosts (network.xml, the discovery server's and its clients') are
+# not embedded: a robot's configuration names them (--qos FILE --participant-profile NAME).
+install(FILES examples/qos/loopback.xml examples/qos/topics.xml examples/qos/ros2_topics.xml examples/qos/network.xml
+              examples/qos/discovery_client.xml examples/qos/discovery_server.xml
         DESTINATION ${CMAKE_INSTALL_DATADIR}/beaconloc/qos COMPONENT runtime)
 install(PROGRAMS scripts/deployment-keys.sh DESTINATION ${CMAKE_INSTALL_DATADIR}/beaconloc COMPONENT runtime)
 install(DIRECTORY DESTINATION ${BEACONLOC_PLUGIN_INSTALL_DIR} COMPONENT runtime)
@@ -49,6 +52,8 @@ set(CPACK_DEBIAN_RUNTIME_PACKAGE_SECTION misc)
 # The shared libraries' packages (Fast DDS, Fast CDR, yaml-cpp, OpenSSL, sqlite3, tinyxml2, libstdc++)
 # found by dpkg-shlibdeps from the executable itself, so they are never listed by hand.
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
+# share/beaconloc/deployment-keys.sh makes a secured deployment's keys with the openssl tool.
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_RECOMMENDS openssl)
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_NAME beaconloc-dev)
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_SECTION libdevel)
 # What building a plugin needs beside the SDK: its headers' dependencies and the tools.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "beaconloc/core/yaml_document.hpp"
@@ -167,33 +168,75 @@ std::vector<std::string> with_config_file(const CLI::App& app, const std::vector
   }
   // The command's settings: "/**"'s, then its own section's, which override them key by key.
   struct Setting {
+    const CLI::Option* option;
     std::string where;  // section.key, for the messages
     YAML::Node value;
+    bool for_every_command;  // from "/**"
   };
-  std::vector<std::pair<const CLI::Option*, Setting>> settings;
+  std::vector<Setting> settings;
   const auto take = [&](const YAML::Node& parameters, const std::string& section) {
     for (const auto& item : parameters) {
       const std::string key = item.first.Scalar();
       const CLI::Option* option = option_of(command, key);
       if (!option) continue;  // "/**" sets it for the commands that have it
-      Setting setting{section + "." + key, item.second};
+      Setting setting{option, section + "." + key, item.second, section == kEveryCommand};
       const auto same =
-          std::find_if(settings.begin(), settings.end(), [&](const auto& s) { return s.first == option; });
+          std::find_if(settings.begin(), settings.end(), [&](const Setting& s) { return s.option == option; });
       if (same == settings.end()) {
-        settings.emplace_back(option, setting);
+        settings.push_back(setting);
       } else {
-        same->second = setting;
+        *same = setting;
       }
     }
   };
   if (every) take(every, kEveryCommand);
   if (own) take(own, command.get_name());
 
+  // The command line overrides the file: a setting it gives itself, and one that excludes an
+  // option it gives (a robot's file names its serial line; `gateway --scenario` simulates instead).
+  const auto on_command_line = [&](const CLI::Option* o) { return given(command_args, o->get_name()); };
+  const auto excluded_by_command_line = [&](const CLI::Option* option) {
+    const std::vector<const CLI::Option*> options = command.get_options();
+    return std::any_of(options.begin(), options.end(), [&](const CLI::Option* other) {
+      return on_command_line(other) && (option->get_excludes().count(const_cast<CLI::Option*>(other)) > 0 ||
+                                        other->get_excludes().count(const_cast<CLI::Option*>(option)) > 0);
+    });
+  };
+  std::set<const CLI::Option*> overridden;
+  for (const Setting& s : settings) {
+    if (on_command_line(s.option) || excluded_by_command_line(s.option)) overridden.insert(s.option);
+  }
+  // Then a setting that needs one of those (the serial line's baud rate), and one of "/**" whose
+  // needs this command lacks (the bridge's beacons file, which the gateway takes only with
+  // --serial): it is for the commands it applies to. A setting of the command's own section whose
+  // needs the file does not meet is kept, for CLI11 to refuse ("--baud requires --serial").
+  const auto kept = [&](const CLI::Option* o) {
+    return on_command_line(o) || std::any_of(settings.begin(), settings.end(), [&](const Setting& s) {
+             return s.option == o && overridden.count(o) == 0;
+           });
+  };
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (const Setting& s : settings) {
+      if (overridden.count(s.option)) continue;
+      for (const CLI::Option* need : s.option->get_needs()) {
+        if (kept(need)) continue;
+        if (overridden.count(need) || s.for_every_command) {
+          overridden.insert(s.option);
+          changed = true;
+          break;
+        }
+      }
+    }
+  }
+
+  // Before a "--" that ends the options, if there is one.
   std::vector<std::string> out = args;
-  for (const auto& [option, setting] : settings) {
-    if (given(command_args, option->get_name())) continue;  // the command line overrides the file
-    const std::vector<std::string> more = file.arguments(*option, setting.where, setting.value);
-    out.insert(out.end(), more.begin(), more.end());
+  auto at = std::find(out.begin() + (chosen - args.begin()) + 1, out.end(), "--");
+  for (const Setting& s : settings) {
+    if (overridden.count(s.option)) continue;
+    const std::vector<std::string> more = file.arguments(*s.option, s.where, s.value);
+    at = out.insert(at, more.begin(), more.end()) + static_cast<std::ptrdiff_t>(more.size());
   }
   return out;
 }

@@ -12,7 +12,10 @@
 // Keys are the commands' long option names without "--"; a scalar is the option's value, a
 // sequence its values (a repeatable option given once per item, or a multi-value option's
 // numbers), true or false a flag. An option given on the command line overrides the file's (the
-// whole key: a --param on the command line replaces the file's list).
+// whole key: a --param on the command line replaces the file's list), and the file's settings that
+// exclude it, with those that need them (`gateway --scenario` on a robot whose file names its
+// serial line and baud rate). A "/**" setting goes to the commands that have the option and meet
+// its needs (a beacons file for the bridge is not the simulated gateway's).
 #include <CLI/CLI.hpp>
 #include <stdexcept>
 #include <string>

@@ -20,7 +20,14 @@ OptionSet dds_option_set(dds::DdsOptions& o) {
              [](CLI::Option* option) { option->check(CLI::ExistingFile); })
       .text("--keystore", o.security.keystore,
             "DDS Security on: the deployment's keystore (scripts/deployment-keys.sh; SROS2 layout)",
-            [](CLI::Option* option) { option->check(CLI::ExistingDirectory); })
+            [](CLI::Option* option) {
+              // An empty value (`--keystore=`, `keystore: ""` in a configuration file) is no
+              // keystore: refused, never taken for "unsecured".
+              option->check(CLI::Validator(
+                  [](std::string& dir) { return dir.empty() ? std::string("no directory given") : std::string(); },
+                  "DIR"));
+              option->check(CLI::ExistingDirectory);
+            })
       .text("--enclave", o.security.enclave,
             "the participant's identity in the keystore (default: its role's, e.g. /beaconloc/decoder; "
             "not with run or demo, whose participants each take their own)");

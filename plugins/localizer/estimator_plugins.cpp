@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <iostream>
+#include <map>
 #include <mutex>
 #include <set>
 
@@ -21,6 +23,12 @@ std::mutex& loaded_mutex() {
 
 std::set<std::string>& loaded_files() {
   static std::set<std::string> files;  // real paths
+  return files;
+}
+
+// The file each plugin estimator came from, for the message when another plugin takes its name.
+std::map<std::string, std::string>& plugin_of_estimator() {
+  static std::map<std::string, std::string> files;
   return files;
 }
 
@@ -44,6 +52,9 @@ std::vector<std::string> load_file(const std::string& file) {
   const std::string real = fs::canonical(file, ec).string();
   if (ec) refuse(file, "cannot be read (" + ec.message() + ")");
   if (loaded_files().count(real)) return {};
+  // Said before the plugin's own code runs (its static initializers, in dlopen): a plugin that
+  // ends the process there is named in the log (the journal, under systemd).
+  std::cerr << "beaconloc: loading estimator plugin " << real << '\n';
   // RTLD_LOCAL: a plugin's symbols (its own copy of the SDK's code) serve it alone; RTLD_NOW: an
   // undefined symbol is found now, with its name, not at the first call.
   void* handle = dlopen(real.c_str(), RTLD_NOW | RTLD_LOCAL);
@@ -82,10 +93,13 @@ std::vector<std::string> load_file(const std::string& file) {
   for (const std::string& name : names) {
     if (!host.factory(name)) continue;
     close();
-    refuse(file, "registers estimator '" + name + "', which this localizer has already");
+    const auto first = plugin_of_estimator().find(name);
+    refuse(file, "registers estimator '" + name + "', which this localizer has already (" +
+                     (first == plugin_of_estimator().end() ? "built in" : "from " + first->second) + ")");
   }
   for (const std::string& name : names) {
     host.add(name, plugin->description(name), plugin->reference_scenario(name), plugin->factory(name));
+    plugin_of_estimator()[name] = real;
   }
   loaded_files().insert(real);  // never closed: the registry holds its factories
   return names;

@@ -20,8 +20,10 @@ class EstimatorPluginError : public std::runtime_error {
 // is skipped. Throws EstimatorPluginError naming the file when it cannot be opened (the loader's
 // reason), is not an estimator plugin (no entry point), was built against another SDK ABI (both
 // given), registers no estimator, or registers a name the localizer has already (built in, or
-// from another plugin); a directory with no *.so file is refused too. Nothing of a refused
-// plugin is added.
+// from another plugin, named); a directory with no *.so file is refused too, and so is a
+// directory holding any *.so that is not an estimator plugin (a helper library belongs elsewhere:
+// every file of the directory is loaded). Nothing of a refused plugin is added. Each file is
+// named on stderr before it is opened (its static initializers run then).
 std::vector<std::string> load_estimator_plugins(const std::vector<std::string>& paths);
 
 }  // namespace beaconloc

@@ -73,6 +73,7 @@ TEST(Cli, BadArgumentsAndConfigurationNameTheCulpritAndFail) {
       {{"gateway", "--no-such-flag"}, "--no-such-flag"},
       {{"decoder", "--config", bad_config}, "'localizer.estimater': localizer has no option --estimater"},
       {{"decoder", "--config", bad_value}, "--domain"},
+      {{"decoder", "--keystore="}, "--keystore"},
       {{"localizer", "--estimator-plugin", bad_xml}, "estimator plugin " + bad_xml + ": cannot be loaded"},
   };
   for (const auto& c : cases) {

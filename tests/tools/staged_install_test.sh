@@ -72,15 +72,17 @@ plugin_dir=$(find "$root/usr/lib" -type d -path '*/beaconloc/estimators')
 
 step "the example plugin built against the unpacked SDK"
 cmake -S "$source_dir/examples/estimator_plugin" -B "$work/plugin" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_PREFIX_PATH="$root/usr" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DCMAKE_INSTALL_PREFIX="$root/usr" \
+  -DCMAKE_PREFIX_PATH="$root/usr" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF \
   >"$work/plugin-configure.log" 2>&1 || { cat "$work/plugin-configure.log"; fail "the plugin's configure failed"; }
 grep -q "$root/usr" "$work/plugin/CMakeCache.txt" || fail "the plugin did not find the unpacked SDK"
 grep "beaconloc_DIR" "$work/plugin/CMakeCache.txt" | grep -q "^beaconloc_DIR:PATH=$root/usr/" ||
   fail "the plugin found another beaconloc: $(grep beaconloc_DIR "$work/plugin/CMakeCache.txt")"
 cmake --build "$work/plugin" >"$work/plugin-build.log" 2>&1 ||
   { cat "$work/plugin-build.log"; fail "the plugin's build failed"; }
-cmake --install "$work/plugin" >/dev/null
-[ -f "$plugin_dir/libexample_placed_ekf.so" ] || fail "the plugin was not installed into $plugin_dir"
+# Into the unpacked SDK's plugin directory (BEACONLOC_ESTIMATOR_PLUGIN_DIR, absolute), nowhere else.
+cmake --install "$work/plugin" >"$work/plugin-install.log"
+grep -q "Installing: $plugin_dir/libexample_placed_ekf.so" "$work/plugin-install.log" ||
+  { cat "$work/plugin-install.log"; fail "the plugin was not installed into $plugin_dir"; }
 
 step "localizer --list-estimators with the packaged plugin directory"
 "$beaconloc" localizer --estimator-plugin "$plugin_dir" --list-estimators >"$work/list.txt" ||

@@ -32,8 +32,20 @@ struct Commands {
     CLI::App* decoder = app.add_subcommand("decoder");
     decoder->add_option("--domain", domain);
     decoder->add_option("--max-range-m", max_range_m);
+    // The gateway's constraints between options: a serial line or a scenario, the line's settings
+    // only with the line.
+    CLI::App* gateway = app.add_subcommand("gateway");
+    CLI::Option* scenario_option = gateway->add_option("--scenario", scenario);
+    CLI::Option* serial_option = gateway->add_option("--serial", serial);
+    serial_option->excludes(scenario_option);
+    gateway->add_option("--baud", baud)->needs(serial_option);
+    gateway->add_option("--beacons", beacons)->needs(serial_option);
     add_config_option(app);
   }
+  std::string scenario;
+  std::string serial;
+  int baud = 0;
+  std::string beacons;
   // Parses `args` with the file's settings; the error message, or "".
   std::string parse(const std::vector<std::string>& args) {
     try {
@@ -41,6 +53,8 @@ struct Commands {
       std::reverse(all.begin(), all.end());
       app.parse(all);
     } catch (const ConfigFileError& e) {
+      return e.what();
+    } catch (const CLI::ParseError& e) {
       return e.what();
     }
     return "";
@@ -98,6 +112,37 @@ TEST(ConfigFile, TheCommandLineOverridesTheFileKeyByKey) {
   Commands without;  // no --config: nothing read
   ASSERT_EQ(without.parse({"localizer", "--domain", "3"}), "");
   EXPECT_EQ(without.estimator, "range_ekf");
+}
+
+// A robot's file names its serial line; the command line simulates instead: the line's settings
+// give way to the option that excludes them, and so do the ones that need it. A "/**" setting
+// applies to the commands whose constraints it meets (the bridge's beacons, not a simulated
+// gateway's); one of the command's own section whose needs the file lacks is refused by CLI11.
+TEST(ConfigFile, TheCommandLineOverridesWhatExcludesItsOptionsAndWhatNeedsThose) {
+  const std::string path = config_file("serial", R"(
+/**:
+  ros__parameters:
+    beacons: site.csv
+gateway:
+  ros__parameters:
+    serial: /dev/ttyUSB0
+    baud: 115200
+)");
+  Commands simulated;
+  ASSERT_EQ(simulated.parse({"gateway", "--config", path, "--scenario", "corridor.yaml"}), "");
+  EXPECT_EQ(simulated.scenario, "corridor.yaml");
+  EXPECT_EQ(simulated.serial, "");
+  EXPECT_EQ(simulated.baud, 0);
+  EXPECT_EQ(simulated.beacons, "");
+  Commands live;
+  ASSERT_EQ(live.parse({"gateway", "--config", path}), "");
+  EXPECT_EQ(live.serial, "/dev/ttyUSB0");
+  EXPECT_EQ(live.baud, 115200);
+  EXPECT_EQ(live.beacons, "site.csv");
+
+  const std::string lacking = config_file("lacking", "gateway:\n  ros__parameters:\n    baud: 9600\n");
+  Commands refused;
+  EXPECT_NE(refused.parse({"gateway", "--config", lacking}).find("--baud requires --serial"), std::string::npos);
 }
 
 TEST(ConfigFile, AnUnknownKeyIsRefusedNamingItWhicheverCommandReadsTheFile) {

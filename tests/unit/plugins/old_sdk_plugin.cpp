@@ -3,7 +3,7 @@
 #include "beaconloc/core/estimator_plugin.hpp"
 
 extern "C" __attribute__((visibility("default"))) const char* beaconloc_estimator_plugin_abi() {
-  return "beaconloc-sdk 0.0; libstdc++ cxx11 abi 1; eigen 3.4.0; eigen static alignment 16";
+  return "beaconloc-sdk 0.0; libstdc++ cxx11 abi 1; eigen 3.4.0; eigen static alignment 16; libstdc++ containers release";
 }
 extern "C" __attribute__((visibility("default"))) const beaconloc::EstimatorRegistry*
 beaconloc_estimator_plugin_registry() {

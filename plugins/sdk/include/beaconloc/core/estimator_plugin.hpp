@@ -20,7 +20,13 @@
 // (Estimator's virtual interface, EstimatorConfig, std::string and std::map, Eigen's fixed-size
 // matrices) to have one layout: the SDK's major and minor version (the estimator API changes only
 // with them; a patch release keeps it), libstdc++'s string ABI, Eigen's version and its static
-// alignment (set by the target's SIMD flags, e.g. -mavx).
+// alignment (set by the target's SIMD flags, e.g. -mavx), and whether libstdc++'s debug
+// containers (_GLIBCXX_DEBUG, another std::map layout) are on.
+#ifdef _GLIBCXX_DEBUG
+#define BEACONLOC_SDK_ABI_CONTAINERS "debug"
+#else
+#define BEACONLOC_SDK_ABI_CONTAINERS "release"
+#endif
 // clang-format off
 #define BEACONLOC_SDK_ABI                                                                               \
   "beaconloc-sdk " BEACONLOC_STRINGIFY(BEACONLOC_SDK_VERSION_MAJOR) "."                                   \
@@ -28,7 +34,8 @@
   "; libstdc++ cxx11 abi " BEACONLOC_STRINGIFY(_GLIBCXX_USE_CXX11_ABI)                                    \
   "; eigen " BEACONLOC_STRINGIFY(EIGEN_WORLD_VERSION) "." BEACONLOC_STRINGIFY(EIGEN_MAJOR_VERSION) "."      \
       BEACONLOC_STRINGIFY(EIGEN_MINOR_VERSION)                                                             \
-  "; eigen static alignment " BEACONLOC_STRINGIFY(EIGEN_MAX_STATIC_ALIGN_BYTES)
+  "; eigen static alignment " BEACONLOC_STRINGIFY(EIGEN_MAX_STATIC_ALIGN_BYTES)                           \
+  "; libstdc++ containers " BEACONLOC_SDK_ABI_CONTAINERS
 // clang-format on
 
 namespace beaconloc {
