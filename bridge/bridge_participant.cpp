@@ -153,7 +153,8 @@ void BridgeParticipant::on_pose(const msg::PoseEstimate& m) {
   auto pose = to_pose_with_covariance(e, options_.map_frame);
   beacon_pose_writer_->write(&pose);
   auto odometry =
-      to_ros_odometry(e, odom_.v_mps(), odom_.omega_radps(), options_.map_frame, options_.base_frame);
+      to_ros_odometry(e, odom_.v_mps(), odom_.omega_radps(), odom_.twist_covariance(), options_.map_frame,
+                      options_.base_frame);
   odometry_out_writer_->write(&odometry);
   if (pending_transforms_.add(e) == PendingTransforms::Added::kQueuedDroppedOldest) {
     counts_.reject("pose.no_odometry_at_stamp");  // beacon_pose went out; map -> odom could not
@@ -232,7 +233,8 @@ void BridgeParticipant::on_ros_odometry(const nav_msgs::msg::Odometry& m) {
     const auto yaw = planar_yaw(m.pose().pose().orientation());
     if (!yaw || !odom_.add_odom_pose(
                     o->stamp_ns, Pose2(m.pose().pose().position().x(), m.pose().pose().position().y(), *yaw),
-                    m.twist().twist().linear().x(), m.twist().twist().angular().z())) {
+                    m.twist().twist().linear().x(), m.twist().twist().angular().z(),
+                    ros_twist_covariance(m))) {
       counts_.reject("odom.bad_or_out_of_order_pose");
       return;
     }

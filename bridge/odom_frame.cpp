@@ -33,6 +33,11 @@ InputResult OdomFrame::add_wheel_odometry(const OdometrySample& o) {
   if (!within_site(pose)) return InputResult::rejected(Rejection::kImplausibleOdomPose);
   v_mps_ = (o.wheel_velocity_right_mps + o.wheel_velocity_left_mps) / 2.0;
   omega_radps_ = (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / o.wheel_base_m;
+  // d[v, omega] / d[v_R, v_L] = [[1/2, 1/2], [1/B_w, -1/B_w]] (the inverse of
+  // wheel_speeds_per_twist): Cov(v, omega) = J Cov(v_R, v_L) J^T.
+  Eigen::Matrix2d j;
+  j << 0.5, 0.5, 1.0 / o.wheel_base_m, -1.0 / o.wheel_base_m;
+  twist_covariance_ = j * o.wheel_velocity_covariance * j.transpose();
   push(o.stamp_ns, pose);
   return step.result;  // accepted, or odometry_gap (taken, not integrated)
 }
@@ -42,11 +47,14 @@ bool OdomFrame::within_site(const Pose2& pose) {
          std::abs(pose.z()) <= kMaxAngleRad;
 }
 
-bool OdomFrame::add_odom_pose(StampNs stamp_ns, const Pose2& pose, double v_mps, double omega_radps) {
-  if (!within_site(pose) || !std::isfinite(v_mps) || !std::isfinite(omega_radps) || !push(stamp_ns, pose))
+bool OdomFrame::add_odom_pose(StampNs stamp_ns, const Pose2& pose, double v_mps, double omega_radps,
+                              const Eigen::Matrix2d& twist_covariance) {
+  if (!within_site(pose) || !std::isfinite(v_mps) || !std::isfinite(omega_radps) || !twist_covariance.allFinite() ||
+      !push(stamp_ns, pose))
     return false;
   v_mps_ = v_mps;
   omega_radps_ = omega_radps;
+  twist_covariance_ = twist_covariance;
   return true;
 }
 

@@ -13,10 +13,9 @@
 
 namespace beaconloc::bridge {
 
-// Not set: rmw's participant USER_DATA ("enclave=/;"). dds::Participant creates the participant
-// from its profile, and setting USER_DATA afterwards (DomainParticipant::set_qos) left Fast DDS
-// 2.9 announcing a stale data locator: a Cyclone DDS writer's samples never reached the bridge.
-// ROS 2 tools build the graph from ros_discovery_info; the enclave only names security contexts.
+// rmw's participant USER_DATA ("enclave=/;") is set by dds::Participant before it creates the
+// participant (set afterwards, DomainParticipant::set_qos, it left Fast DDS 2.9 announcing a stale
+// data locator: a Cyclone DDS writer's samples never reached the bridge).
 // rmw's topic of the graph (no rt/ prefix: it is not a ROS topic).
 inline constexpr const char* kRosDiscoveryInfoTopic = "ros_discovery_info";
 

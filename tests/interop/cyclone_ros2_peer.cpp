@@ -26,6 +26,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -103,14 +104,21 @@ std::set<Guid> ros_endpoints_of(dds_entity_t builtin_reader, const Guid& partici
 }
 
 // Whether discovery found the participant of that GUID.
-bool participant_discovered(dds_entity_t participants_reader, const Guid& participant) {
-  bool found = false;
+// The user data of that participant as discovered (rmw's "enclave=<enclave>;"), or nullopt when it
+// was not discovered.
+std::optional<std::string> discovered_user_data(dds_entity_t participants_reader, const Guid& participant) {
+  std::optional<std::string> found;
   void* samples[64] = {nullptr};
   dds_sample_info_t infos[64];
   const int n = dds_read(participants_reader, samples, infos, 64, 64);
   for (int i = 0; i < n; ++i) {
     const auto* p = static_cast<const dds_builtintopic_participant_t*>(samples[i]);
-    if (infos[i].valid_data && guid_of(p->key) == participant) found = true;
+    if (!infos[i].valid_data || guid_of(p->key) != participant) continue;
+    void* data = nullptr;
+    size_t size = 0;
+    found = dds_qget_userdata(p->qos, &data, &size) && data ? std::string(static_cast<const char*>(data), size)
+                                                            : std::string();
+    dds_free(data);
   }
   if (n > 0) dds_return_loan(participants_reader, samples, n);
   return found;
@@ -154,8 +162,11 @@ std::string graph_problem(const NodeInGraph& node, dds_entity_t publications, dd
            "found " +
            std::to_string(readers.size()) + " rt/ readers on its participant (or other GIDs)";
   }
-  if (!participant_discovered(participants, node.participant)) {
-    return "the node's participant (ros_discovery_info's gid) was not discovered";
+  const std::optional<std::string> user_data = discovered_user_data(participants, node.participant);
+  if (!user_data) return "the node's participant (ros_discovery_info's gid) was not discovered";
+  // What rmw puts in a ROS 2 participant's user data, and ros2 tools read: its enclave.
+  if (user_data->rfind("enclave=", 0) != 0 || user_data->back() != ';') {
+    return "the node's participant has user data '" + *user_data + "', not rmw's enclave=<enclave>;";
   }
   return "";
 }
@@ -473,6 +484,12 @@ int main(int argc, char** argv) {
         c.expect(tr.transform.translation.x == 0.0 && tr.transform.translation.y == 0.0 &&
                      tr.transform.rotation.w == 1.0,
                  "tf_static: the receiver at the base's centre");
+        // Stamped with the time it was published (static_transform_publisher's now()), not 0:
+        // within this run's minute of the wall clock.
+        const double stamp_s = tr.header.stamp.sec + 1e-9 * tr.header.stamp.nanosec;
+        const double now_s =
+            std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+        c.expect(stamp_s > 0.0 && std::abs(now_s - stamp_s) < 60.0, "tf_static: stamped with the current time");
       }
       if (c.failures.empty()) tf_static_ok = true;
       if (tf_static_steady_ns < 0) {
