@@ -122,7 +122,6 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
       std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] { return diagnostics_snapshot(); });
 }
 
-
 void BridgeParticipant::publish_static_frames() {
   // base_link -> receiver_<i>, all in one message (tf2's convention for /tf_static), stamped with
   // the time they are published, as static_transform_publisher stamps with now().

@@ -34,10 +34,13 @@ InputResult OdomFrame::add_wheel_odometry(const OdometrySample& o) {
   v_mps_ = (o.wheel_velocity_right_mps + o.wheel_velocity_left_mps) / 2.0;
   omega_radps_ = (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / o.wheel_base_m;
   // d[v, omega] / d[v_R, v_L] = [[1/2, 1/2], [1/B_w, -1/B_w]] (the inverse of
-  // wheel_speeds_per_twist): Cov(v, omega) = J Cov(v_R, v_L) J^T.
-  Eigen::Matrix2d j;
-  j << 0.5, 0.5, 1.0 / o.wheel_base_m, -1.0 / o.wheel_base_m;
-  twist_covariance_ = j * o.wheel_velocity_covariance * j.transpose();
+  // wheel_speeds_per_twist): Cov(v, omega) = J Cov(v_R, v_L) J^T, written out so that it is exactly
+  // symmetric (a matrix product rounds its two off-diagonal entries differently).
+  const double var_right = o.wheel_velocity_covariance(0, 0), cross = o.wheel_velocity_covariance(0, 1),
+               var_left = o.wheel_velocity_covariance(1, 1), base_m = o.wheel_base_m;
+  const double cov_v_omega = (var_right - var_left) / (2.0 * base_m);
+  twist_covariance_ << (var_right + 2.0 * cross + var_left) / 4.0, cov_v_omega, cov_v_omega,
+      (var_right - 2.0 * cross + var_left) / (base_m * base_m);
   push(o.stamp_ns, pose);
   return step.result;  // accepted, or odometry_gap (taken, not integrated)
 }

@@ -119,12 +119,12 @@ std::optional<OdometrySample> from_ros_odometry(const nav_msgs::msg::Odometry& m
   if (!stamp) return refused<OdometrySample>(why_not, "bad_stamp");
   const double v = m.twist().twist().linear().x(), omega = m.twist().twist().angular().z();
   if (!std::isfinite(v) || !std::isfinite(omega)) return refused<OdometrySample>(why_not, "non_finite_twist");
-  // The (v, omega) covariance: finite, symmetric, positive semi-definite (a driver's unset one,
-  // all zeros, is that too).
+  // The (v, omega) covariance: finite, symmetric, variances >= 0 (a driver's unset one, all zeros,
+  // is that too). Whether it is positive semi-definite is judged on the wheels' covariance it
+  // becomes (the same for an invertible map), by the localizer's own check below.
   const Eigen::Matrix2d twist_covariance = ros_twist_covariance(m);
   if (!twist_covariance.allFinite() || twist_covariance(0, 1) != twist_covariance(1, 0) ||
-      twist_covariance(0, 0) < 0.0 || twist_covariance(1, 1) < 0.0 ||
-      twist_covariance(0, 1) * twist_covariance(0, 1) > twist_covariance(0, 0) * twist_covariance(1, 1)) {
+      twist_covariance(0, 0) < 0.0 || twist_covariance(1, 1) < 0.0) {
     return refused<OdometrySample>(why_not, "bad_twist_covariance");
   }
   OdometrySample o;
@@ -135,8 +135,14 @@ std::optional<OdometrySample> from_ros_odometry(const nav_msgs::msg::Odometry& m
   const Eigen::Vector2d wheels_mps = wheel_speeds_mps(v, omega, wheel_base_m);
   o.wheel_velocity_right_mps = wheels_mps(0);
   o.wheel_velocity_left_mps = wheels_mps(1);
-  const Eigen::Matrix2d j = wheel_speeds_per_twist(wheel_base_m);
-  o.wheel_velocity_covariance = j * twist_covariance * j.transpose();
+  // J C J^T with J = wheel_speeds_per_twist = [[1, h], [1, -h]], h = B / 2, written out so that it
+  // is exactly symmetric (a matrix product rounds its two off-diagonal entries differently, and
+  // the localizer refuses an asymmetric covariance).
+  const double h = wheel_base_m / 2.0;
+  const double var_v = twist_covariance(0, 0), cov_v_omega = twist_covariance(0, 1), var_omega = twist_covariance(1, 1);
+  const double right_left = var_v - h * h * var_omega;
+  o.wheel_velocity_covariance << var_v + 2.0 * h * cov_v_omega + h * h * var_omega, right_left, right_left,
+      var_v - 2.0 * h * cov_v_omega + h * h * var_omega;
   // What the localizer would refuse is refused here, by the same checks and reasons: a huge
   // finite twist is an infinite wheel speed on the bus.
   if (const InputResult checked = check_odometry_numbers(o); !checked.accepted) {

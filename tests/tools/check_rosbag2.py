@@ -513,7 +513,8 @@ TWIST_VX, TWIST_WZ = 0, 5  # rows of the twist covariance: vx, vy, vz, wx, wy, w
 
 def twist_covariance(right_var, cross, left_var, base):
     """Cov(v, omega) of wheel speeds with covariance [[right_var, cross], [cross, left_var]], through
-    v = (right + left) / 2, omega = (right - left) / base, as (var_v, cov_v_omega, var_omega)."""
+    v = (right + left) / 2, omega = (right - left) / base, as (var_v, cov_v_omega, var_omega): J C J^T
+    with J = [[1/2, 1/2], [1/base, -1/base]], multiplied out by hand."""
     return ((right_var + 2.0 * cross + left_var) / 4.0, (right_var - left_var) / (2.0 * base),
             (right_var - 2.0 * cross + left_var) / (base * base))
 
@@ -533,9 +534,6 @@ def check_twists(path, decoded, problems):
             reported.setdefault(key, []).append(twist_covariance(
                 float(line["var_right"]), float(line["cov_right_left"]), float(line["var_left"]), base))
 
-    def close(a, b):
-        return abs(a - b) <= 1e-12 * max(abs(a), abs(b)) + 1e-300
-
     def block(m):
         return (m["twist_cov%d" % (TWIST_VX * 6 + TWIST_VX)], m["twist_cov%d" % (TWIST_VX * 6 + TWIST_WZ)],
                 m["twist_cov%d" % (TWIST_WZ * 6 + TWIST_WZ)])
@@ -551,7 +549,8 @@ def check_twists(path, decoded, problems):
         if (m["vx"], m["wz"]) == (0.0, 0.0) and block(m) == (UNKNOWN_TWIST_VARIANCE, 0.0, UNKNOWN_TWIST_VARIANCE):
             return True
         candidates = reported.get((float_bits(m["vx"]), float_bits(m["wz"])), [])
-        return any(all(close(a, b) for a, b in zip(block(m), c)) for c in candidates)
+        # Bit for bit: the bridge computes the same expressions in the same order (odom_frame.cpp).
+        return any(tuple(float_bits(v) for v in block(m)) == tuple(float_bits(v) for v in c) for c in candidates)
 
     bad = [m for m in decoded if not fits(m)]
     for m in bad[:MAX_REPORTED]:

@@ -89,14 +89,23 @@ TEST(Ros2Bridge, DriverOdometryBecomesWheelSpeedsAndBadOnesAreRefused) {
                2 * o->wheel_velocity_covariance(0, 1)) /
                   4.0,
               0.01, 1e-12);
-  // A covariance that is no covariance (asymmetric, not positive semi-definite, negative) is
-  // refused, not repaired.
-  for (const auto& [cross_vw, cross_wv] : {std::pair{0.001, 0.002}, std::pair{0.05, 0.05}}) {
-    m.twist().covariance()[5] = cross_vw;
-    m.twist().covariance()[30] = cross_wv;
-    EXPECT_FALSE(from_ros_odometry(m, 0.4, &why)) << cross_vw;
-    EXPECT_EQ(why, "bad_twist_covariance");
+  // A cross term of v and omega goes to the wheels, exactly symmetric (for every valid one: the
+  // localizer refuses an asymmetric covariance).
+  for (const double cross : {0.005, -0.013, 1e-3 / 3.0, 0.019}) {
+    m.twist().covariance()[5] = m.twist().covariance()[30] = cross;
+    const auto with_cross = from_ros_odometry(m, 0.4, &why);
+    ASSERT_TRUE(with_cross) << cross << " " << why;
+    EXPECT_EQ(with_cross->wheel_velocity_covariance(0, 1), with_cross->wheel_velocity_covariance(1, 0)) << cross;
   }
+  // A covariance that is no covariance (asymmetric, negative, not positive semi-definite) is
+  // refused, not repaired.
+  m.twist().covariance()[5] = 0.001;
+  m.twist().covariance()[30] = 0.002;
+  EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
+  EXPECT_EQ(why, "bad_twist_covariance");
+  m.twist().covariance()[5] = m.twist().covariance()[30] = 0.05;  // 0.05^2 > 0.01 * 0.04
+  EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
+  EXPECT_EQ(why, "invalid_odometry_covariance");
   m.twist().covariance()[5] = m.twist().covariance()[30] = 0.0;
   m.twist().covariance()[35] = -0.04;
   EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
@@ -176,9 +185,6 @@ TEST(Ros2Bridge, MapToOdomComposesToTheEstimate) {
   EXPECT_FALSE(odom.pose_odom_base(2'000'000'000));
 }
 
-// A clock that steps forward (a gateway stamping data time replaced by one stamping wall-clock
-// time) is a gap: not integrated (1.7e9 s at 1 m/s put the frame beyond any site, and every later
-// sample was refused, freezing map -> odom), but taken, and the frame goes on from where it was.
 // odometry/beacons states what the wheels support: their reported covariance carried to (v, omega)
 // (v = (v_R + v_L) / 2, omega = (v_R - v_L) / B), at (vx, wz) of the 6x6; before any odometry, a
 // twist not known (a large variance), never a certain standstill; a driver's own covariance as given.
@@ -195,7 +201,7 @@ TEST(Ros2Bridge, TheOdometrysTwistCovarianceIsTheWheelsCarriedToVAndOmega) {
   const Eigen::Matrix2d& c = odom.twist_covariance();
   EXPECT_NEAR(c(0, 0), 15e-4 / 4.0, 1e-15);
   EXPECT_NEAR(c(0, 1), -5e-4 / 1.0, 1e-15);
-  EXPECT_NEAR(c(1, 0), c(0, 1), 1e-18);
+  EXPECT_EQ(c(1, 0), c(0, 1));  // exactly: a covariance on the wire is symmetric
   EXPECT_NEAR(c(1, 1), 11e-4 / 0.25, 1e-15);
 
   PoseEstimate e;
@@ -217,6 +223,9 @@ TEST(Ros2Bridge, TheOdometrysTwistCovarianceIsTheWheelsCarriedToVAndOmega) {
                                   Eigen::Matrix2d::Constant(std::nan(""))));
 }
 
+// A clock that steps forward (a gateway stamping data time replaced by one stamping wall-clock
+// time) is a gap: not integrated (1.7e9 s at 1 m/s put the frame beyond any site, and every later
+// sample was refused, freezing map -> odom), but taken, and the frame goes on from where it was.
 TEST(Ros2Bridge, TheOdomFrameGoesOnAcrossAClockStepForward) {
   OdomFrame odom;
   OdometrySample o;
