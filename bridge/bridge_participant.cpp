@@ -10,6 +10,7 @@
 #include "beaconloc/dds/topics.hpp"
 #include "beaconloc/dds/wall_clock.hpp"
 #include "ros2_convert.hpp"
+#include "ros_graph.hpp"
 
 namespace beaconloc::bridge {
 
@@ -68,23 +69,27 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
       {beacons_topic_.c_str(), "ros2.beacons.writer", ""});
   ranges_writer_ = participant_.writer<sensor_msgs::msg::RangePubSubType>(
       {ranges_topic_.c_str(), "ros2.beacon_ranges.writer", ""});
+  std::vector<eprosima::fastrtps::rtps::GUID_t> ros_readers;  // the node's, for ros_discovery_info
   if (options_.odometry_in) {
     odometry_in_writer_ = participant_.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, options_.robot_id);
     readers_.push_back(participant_.subscribe<nav_msgs::msg::OdometryPubSubType>(
         {odom_in_topic_.c_str(), "", "ros2.odom.reader"},
         [this](const nav_msgs::msg::Odometry& m) { on_ros_odometry(m); }));
+    ros_readers.push_back(readers_.back()->guid());
   }
   if (options_.scan_in) {
     scan_in_writer_ = participant_.robot_writer<msg::LaserScanPubSubType>(dds::kLaserScanTopic, options_.robot_id);
     readers_.push_back(participant_.subscribe<sensor_msgs::msg::LaserScanPubSubType>(
         {scan_in_topic_.c_str(), "", "ros2.scan.reader"},
         [this](const sensor_msgs::msg::LaserScan& m) { on_ros_scan(m); }));
+    ros_readers.push_back(readers_.back()->guid());
   }
   initial_pose_writer_ =
       participant_.robot_writer<msg::InitialPosePubSubType>(dds::kInitialPoseTopic, options_.robot_id);
   readers_.push_back(participant_.subscribe<geometry_msgs::msg::PoseWithCovarianceStampedPubSubType>(
       {initial_pose_topic_.c_str(), "", "ros2.initialpose.reader"},
       [this](const geometry_msgs::msg::PoseWithCovarianceStamped& m) { on_ros_initial_pose(m); }));
+  ros_readers.push_back(readers_.back()->guid());
   readers_.push_back(participant_.subscribe<msg::PoseEstimatePubSubType>(dds::kPoseEstimateTopic,
                                                       [this](const msg::PoseEstimate& m) { on_pose(m); }));
   readers_.push_back(participant_.subscribe<msg::OdometryPubSubType>(dds::kOdometryTopic,
@@ -102,16 +107,29 @@ BridgeParticipant::BridgeParticipant(const dds::DdsOptions& dds, BridgeOptions o
     auto markers = beacon_markers(*options_.beacons, options_.map_frame, dds::wall_clock_ns());
     beacons_writer_->write(&markers);
   }
+  // The node in the ROS 2 graph, once all its ROS endpoints exist. Not when secured: the
+  // deployment's permissions (scripts/deployment-keys.sh) do not grant ros_discovery_info yet.
+  if (!participant_.secured()) {
+    ros_discovery_info_writer_ = participant_.writer<rmw_dds_common::msg::ParticipantEntitiesInfoPubSubType>(
+        {kRosDiscoveryInfoTopic, "ros2.ros_discovery_info.writer", ""});
+    auto graph = node_entities(beacon_pose_writer_->get_publisher()->get_participant()->guid(),
+                               options_.ros_namespace, ros_node_name(options_.robot_id), ros_readers,
+                               {beacon_pose_writer_->guid(), odometry_out_writer_->guid(), tf_writer_->guid(),
+                                tf_static_writer_->guid(), beacons_writer_->guid(), ranges_writer_->guid()});
+    ros_discovery_info_writer_->write(&graph);
+  }
   diagnostics_ =
       std::make_unique<dds::DiagnosticsPublisher>(participant_, [this] { return diagnostics_snapshot(); });
 }
 
 void BridgeParticipant::publish_static_frames() {
-  // base_link -> receiver_<i>, all in one message (tf2's convention for /tf_static).
+  // base_link -> receiver_<i>, all in one message (tf2's convention for /tf_static), stamped with
+  // the time they are published, as static_transform_publisher stamps with now().
+  const StampNs now_ns = dds::wall_clock_ns();
   tf2_msgs::msg::TFMessage frames;
   for (std::size_t i = 0; i < options_.receivers.size(); ++i) {
     const Eigen::Vector2d& r = options_.receivers.receivers_base_m[i];
-    frames.transforms().push_back(to_transform(0, Pose2(r.x(), r.y(), 0.0), options_.base_frame,
+    frames.transforms().push_back(to_transform(now_ns, Pose2(r.x(), r.y(), 0.0), options_.base_frame,
                                                "receiver_" + std::to_string(i),
                                                options_.receivers.receiver_height_m));
   }
@@ -134,7 +152,8 @@ void BridgeParticipant::on_pose(const msg::PoseEstimate& m) {
   auto pose = to_pose_with_covariance(e, options_.map_frame);
   beacon_pose_writer_->write(&pose);
   auto odometry =
-      to_ros_odometry(e, odom_.v_mps(), odom_.omega_radps(), options_.map_frame, options_.base_frame);
+      to_ros_odometry(e, odom_.v_mps(), odom_.omega_radps(), odom_.twist_covariance(), options_.map_frame,
+                      options_.base_frame);
   odometry_out_writer_->write(&odometry);
   if (pending_transforms_.add(e) == PendingTransforms::Added::kQueuedDroppedOldest) {
     counts_.reject("pose.no_odometry_at_stamp");  // beacon_pose went out; map -> odom could not
@@ -213,7 +232,8 @@ void BridgeParticipant::on_ros_odometry(const nav_msgs::msg::Odometry& m) {
     const auto yaw = planar_yaw(m.pose().pose().orientation());
     if (!yaw || !odom_.add_odom_pose(
                     o->stamp_ns, Pose2(m.pose().pose().position().x(), m.pose().pose().position().y(), *yaw),
-                    m.twist().twist().linear().x(), m.twist().twist().angular().z())) {
+                    m.twist().twist().linear().x(), m.twist().twist().angular().z(),
+                    ros_twist_covariance(m))) {
       counts_.reject("odom.bad_or_out_of_order_pose");
       return;
     }

@@ -3,6 +3,7 @@
 // names, QoS of examples/qos/ros2_topics.xml). No ROS 2 code: the types are IDL (idl/ros2).
 //  out: beacon_pose, odometry/beacons, tf (map -> odom), tf_static (receiver frames), beacons
 //       (MarkerArray of the beacon map), beacon_ranges (sensor_msgs/Range per accepted range);
+//  graph: the node beaconloc_bridge_<robot> on ros_discovery_info, for ROS 2 tools (ros_graph.hpp);
 //  in:  odom (nav_msgs/Odometry) and scan (sensor_msgs/LaserScan) from a ROS 2 robot's drivers,
 //       republished as the project's Odometry and LaserScan; initialpose (rviz2's 2D Pose
 //       Estimate, Nav2) as the project's InitialPose, which restarts the localizer there.
@@ -100,6 +101,7 @@ class BridgeParticipant {
   dds::Writer odometry_in_writer_;
   dds::Writer scan_in_writer_;
   dds::Writer initial_pose_writer_;
+  dds::Writer ros_discovery_info_writer_;  // the node and its endpoints in the ROS 2 graph
   // Before diagnostics_, which reports its count: it goes after the Diagnostics task stops.
   std::unique_ptr<dds::FirstSampleWatch> map_reader_;  // recreated when mute (first_sample_watch.hpp)
   std::unique_ptr<dds::DiagnosticsPublisher> diagnostics_;

@@ -33,6 +33,14 @@ InputResult OdomFrame::add_wheel_odometry(const OdometrySample& o) {
   if (!within_site(pose)) return InputResult::rejected(Rejection::kImplausibleOdomPose);
   v_mps_ = (o.wheel_velocity_right_mps + o.wheel_velocity_left_mps) / 2.0;
   omega_radps_ = (o.wheel_velocity_right_mps - o.wheel_velocity_left_mps) / o.wheel_base_m;
+  // d[v, omega] / d[v_R, v_L] = [[1/2, 1/2], [1/B_w, -1/B_w]] (the inverse of
+  // wheel_speeds_per_twist): Cov(v, omega) = J Cov(v_R, v_L) J^T, written out so that it is exactly
+  // symmetric (a matrix product rounds its two off-diagonal entries differently).
+  const double var_right = o.wheel_velocity_covariance(0, 0), cross = o.wheel_velocity_covariance(0, 1),
+               var_left = o.wheel_velocity_covariance(1, 1), base_m = o.wheel_base_m;
+  const double cov_v_omega = (var_right - var_left) / (2.0 * base_m);
+  twist_covariance_ << (var_right + 2.0 * cross + var_left) / 4.0, cov_v_omega, cov_v_omega,
+      (var_right - 2.0 * cross + var_left) / (base_m * base_m);
   push(o.stamp_ns, pose);
   return step.result;  // accepted, or odometry_gap (taken, not integrated)
 }
@@ -42,11 +50,14 @@ bool OdomFrame::within_site(const Pose2& pose) {
          std::abs(pose.z()) <= kMaxAngleRad;
 }
 
-bool OdomFrame::add_odom_pose(StampNs stamp_ns, const Pose2& pose, double v_mps, double omega_radps) {
-  if (!within_site(pose) || !std::isfinite(v_mps) || !std::isfinite(omega_radps) || !push(stamp_ns, pose))
+bool OdomFrame::add_odom_pose(StampNs stamp_ns, const Pose2& pose, double v_mps, double omega_radps,
+                              const Eigen::Matrix2d& twist_covariance) {
+  if (!within_site(pose) || !std::isfinite(v_mps) || !std::isfinite(omega_radps) || !twist_covariance.allFinite() ||
+      !push(stamp_ns, pose))
     return false;
   v_mps_ = v_mps;
   omega_radps_ = omega_radps;
+  twist_covariance_ = twist_covariance;
   return true;
 }
 

@@ -25,8 +25,10 @@ class OdomFrame {
   InputResult add_wheel_odometry(const OdometrySample& o);
   // The estimators' default max_odometry_gap_s.
   static constexpr double kMaxIntegratedGapS = kDefaultMaxOdometryGapS;
-  // A driver's own odom -> base pose (finite, within a site's extent), and its finite twist.
-  bool add_odom_pose(StampNs stamp_ns, const Pose2& pose_odom_base, double v_mps, double omega_radps);
+  // A driver's own odom -> base pose (finite, within a site's extent), its finite twist and the
+  // twist's covariance as the driver stated it (finite, variances >= 0: from_ros_odometry checks).
+  bool add_odom_pose(StampNs stamp_ns, const Pose2& pose_odom_base, double v_mps, double omega_radps,
+                     const Eigen::Matrix2d& twist_covariance);
   // odom -> base at stamp_ns, interpolated between neighbours; nullopt outside the history.
   std::optional<Pose2> pose_odom_base(StampNs stamp_ns) const;
   // map -> odom from a pose estimate stamped stamp_ns.
@@ -35,9 +37,16 @@ class OdomFrame {
   std::optional<StampNs> latest_stamp_ns() const {
     return poses_.empty() ? std::nullopt : std::optional<StampNs>(poses_.back().first);
   }
-  // The latest wheel odometry's twist (v, omega), for nav_msgs/Odometry.
+  // The latest wheel odometry's twist (v, omega), for nav_msgs/Odometry, and its covariance over
+  // (v, omega): the wheel speeds' reported covariance carried through v = (v_R + v_L) / 2,
+  // omega = (v_R - v_L) / B_w, or the driver's own. Before any odometry, the twist is unknown:
+  // (0, 0) with kUnknownTwistVariance on the diagonal, not a certain standstill.
   double v_mps() const { return v_mps_; }
   double omega_radps() const { return omega_radps_; }
+  const Eigen::Matrix2d& twist_covariance() const { return twist_covariance_; }
+  // A variance that says "not known" (robot_localization's advice for unmeasured quantities: a
+  // large one), (m/s)^2 and (rad/s)^2: 1000 m/s and rad/s of standard deviation.
+  static constexpr double kUnknownTwistVariance = 1e6;
 
  private:
   bool push(StampNs stamp_ns, const Pose2& pose);
@@ -47,6 +56,7 @@ class OdomFrame {
   std::deque<std::pair<StampNs, Pose2>> poses_;
   double v_mps_ = 0.0;
   double omega_radps_ = 0.0;
+  Eigen::Matrix2d twist_covariance_ = kUnknownTwistVariance * Eigen::Matrix2d::Identity();
 };
 
 }  // namespace beaconloc::bridge

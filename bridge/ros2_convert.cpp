@@ -101,14 +101,30 @@ std::optional<InitialPose> from_initial_pose(const geometry_msgs::msg::PoseWithC
   return InitialPose{*stamp, Pose2(x, y, *yaw), c};
 }
 
+namespace {
+constexpr int kTwistVx = 0;  // the twist covariance's rows: vx, vy, vz, wx, wy, wz
+constexpr int kTwistWz = 5;
+}  // namespace
+
+Eigen::Matrix2d ros_twist_covariance(const nav_msgs::msg::Odometry& m) {
+  const auto& c = m.twist().covariance();
+  Eigen::Matrix2d out;
+  out << c[kTwistVx * 6 + kTwistVx], c[kTwistVx * 6 + kTwistWz], c[kTwistWz * 6 + kTwistVx], c[kTwistWz * 6 + kTwistWz];
+  return out;
+}
+
 std::optional<OdometrySample> from_ros_odometry(const nav_msgs::msg::Odometry& m, double wheel_base_m,
                                                 std::string* why_not) {
   const auto stamp = from_ros_time(m.header().stamp());
   if (!stamp) return refused<OdometrySample>(why_not, "bad_stamp");
   const double v = m.twist().twist().linear().x(), omega = m.twist().twist().angular().z();
   if (!std::isfinite(v) || !std::isfinite(omega)) return refused<OdometrySample>(why_not, "non_finite_twist");
-  const double var_v = m.twist().covariance()[0], var_omega = m.twist().covariance()[35];
-  if (!std::isfinite(var_v) || !std::isfinite(var_omega) || var_v < 0.0 || var_omega < 0.0) {
+  // The (v, omega) covariance: finite, symmetric, variances >= 0 (a driver's unset one, all zeros,
+  // is that too). Whether it is positive semi-definite is judged on the wheels' covariance it
+  // becomes (the same for an invertible map), by the localizer's own check below.
+  const Eigen::Matrix2d twist_covariance = ros_twist_covariance(m);
+  if (!twist_covariance.allFinite() || twist_covariance(0, 1) != twist_covariance(1, 0) ||
+      twist_covariance(0, 0) < 0.0 || twist_covariance(1, 1) < 0.0) {
     return refused<OdometrySample>(why_not, "bad_twist_covariance");
   }
   OdometrySample o;
@@ -119,8 +135,14 @@ std::optional<OdometrySample> from_ros_odometry(const nav_msgs::msg::Odometry& m
   const Eigen::Vector2d wheels_mps = wheel_speeds_mps(v, omega, wheel_base_m);
   o.wheel_velocity_right_mps = wheels_mps(0);
   o.wheel_velocity_left_mps = wheels_mps(1);
-  const Eigen::Matrix2d j = wheel_speeds_per_twist(wheel_base_m);
-  o.wheel_velocity_covariance = j * Eigen::Vector2d(var_v, var_omega).asDiagonal() * j.transpose();
+  // J C J^T with J = wheel_speeds_per_twist = [[1, h], [1, -h]], h = B / 2, written out so that it
+  // is exactly symmetric (a matrix product rounds its two off-diagonal entries differently, and
+  // the localizer refuses an asymmetric covariance).
+  const double h = wheel_base_m / 2.0;
+  const double var_v = twist_covariance(0, 0), cov_v_omega = twist_covariance(0, 1), var_omega = twist_covariance(1, 1);
+  const double right_left = var_v - h * h * var_omega;
+  o.wheel_velocity_covariance << var_v + 2.0 * h * cov_v_omega + h * h * var_omega, right_left, right_left,
+      var_v - 2.0 * h * cov_v_omega + h * h * var_omega;
   // What the localizer would refuse is refused here, by the same checks and reasons: a huge
   // finite twist is an infinite wheel speed on the bus.
   if (const InputResult checked = check_odometry_numbers(o); !checked.accepted) {
@@ -153,7 +175,8 @@ std::optional<LaserScanSample> from_ros_scan(const sensor_msgs::msg::LaserScan& 
 }
 
 nav_msgs::msg::Odometry to_ros_odometry(const PoseEstimate& e, double v, double omega,
-                                        const std::string& map_frame, const std::string& base_frame) {
+                                        const Eigen::Matrix2d& twist_covariance, const std::string& map_frame,
+                                        const std::string& base_frame) {
   nav_msgs::msg::Odometry m;
   m.header().stamp(to_ros_time(e.stamp_ns));
   m.header().frame_id(map_frame);
@@ -164,6 +187,12 @@ nav_msgs::msg::Odometry to_ros_odometry(const PoseEstimate& e, double v, double 
   place_planar_covariance(e.covariance, m.pose().covariance().data());
   m.twist().twist().linear().x(v);
   m.twist().twist().angular().z(omega);
+  double* c = m.twist().covariance().data();
+  for (int i = 0; i < 36; ++i) c[i] = 0.0;
+  c[kTwistVx * 6 + kTwistVx] = twist_covariance(0, 0);
+  c[kTwistVx * 6 + kTwistWz] = twist_covariance(0, 1);
+  c[kTwistWz * 6 + kTwistVx] = twist_covariance(1, 0);
+  c[kTwistWz * 6 + kTwistWz] = twist_covariance(1, 1);
   return m;
 }
 

@@ -40,14 +40,20 @@ std::optional<InitialPose> from_initial_pose(const geometry_msgs::msg::PoseWithC
 
 // Odometry of a ROS 2 robot driver (twist in the base frame: linear.x, angular.z) as the wheel
 // velocities of a differential drive of wheel_base_m, with their covariance from the twist's.
+// The (linear.x, angular.z) block of a nav_msgs/Odometry's twist covariance (row-major 6x6 over
+// vx, vy, vz, wx, wy, wz), as given: from_ros_odometry checks it.
+Eigen::Matrix2d ros_twist_covariance(const nav_msgs::msg::Odometry& m);
 std::optional<OdometrySample> from_ros_odometry(const nav_msgs::msg::Odometry& m, double wheel_base_m,
                                                 std::string* why_not);
 
 std::optional<LaserScanSample> from_ros_scan(const sensor_msgs::msg::LaserScan& m, std::string* why_not);
 
-// The pose estimate with the robot's twist (from its wheel odometry) as nav_msgs/Odometry.
+// The pose estimate with the robot's twist (from its wheel odometry) as nav_msgs/Odometry: the
+// twist's covariance is twist_covariance over (linear.x, angular.z); the other components of a
+// planar robot's twist are 0 with 0 variance, as the pose's z, roll and pitch.
 nav_msgs::msg::Odometry to_ros_odometry(const PoseEstimate& e, double v_mps, double omega_radps,
-                                        const std::string& map_frame, const std::string& base_frame);
+                                        const Eigen::Matrix2d& twist_covariance, const std::string& map_frame,
+                                        const std::string& base_frame);
 
 geometry_msgs::msg::TransformStamped to_transform(StampNs stamp_ns, const Pose2& parent_child,
                                                   const std::string& parent, const std::string& child,

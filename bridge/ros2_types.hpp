@@ -2,6 +2,8 @@
 // The generated ROS 2 types of the distro chosen at build time (idl/CMakeLists.txt).
 #include <ros2_common.h>
 #include <ros2_commonPubSubTypes.h>
+#include <ros2_graph.h>
+#include <ros2_graphPubSubTypes.h>
 #if defined(BEACONLOC_ROS2_HUMBLE)
 #include <ros2_humble.h>
 #include <ros2_humblePubSubTypes.h>

@@ -17,6 +17,9 @@ if [ "$type" = Asan ]; then
   cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DBEACONLOC_SANITIZE=ON -DBEACONLOC_BUILD_BENCHMARKS=OFF \
     -DBEACONLOC_WERROR=ON >/dev/null
 else
-  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE="$type" -DBEACONLOC_WERROR=ON >/dev/null
+  # Configured for /usr: the Debian packages are made of this build (cpack -G DEB,
+  # cmake/BeaconlocInstall.cmake; docs/deployment.md). Install it anywhere else with
+  # cmake --install build/release --prefix DIR.
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE="$type" -DBEACONLOC_WERROR=ON -DCMAKE_INSTALL_PREFIX=/usr >/dev/null
 fi
 cmake --build "$dir" -j 2

@@ -6,7 +6,7 @@
 # starts from a scratch copy of tests/fuzz/corpus/<target>/ (the repository's corpus is never
 # written) and stops at the first crash, leak, undefined behaviour, timeout (10 s per input) or
 # allocation over 256 MB; the input is kept in build/fuzz/artifacts/. Exits 1 if any target
-# found something, 2 on a usage error. CI: bash scripts/fuzz.sh --seconds 20.
+# found something, 2 on a usage error. CI: bash scripts/fuzz.sh --seconds 10.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -14,10 +14,13 @@ $SUDO apt-get install -y --no-install-recommends \
   fastdds-tools iproute2 \
   openssl libssl-dev \
   libsqlite3-dev socat python3 python3-yaml \
+  dpkg-dev file \
   clang libclang-rt-14-dev llvm
 # libsqlite3-dev (beaconloc record writes rosbag2's sqlite3 storage), socat (the serial gateway's
 # tests: linked pseudo-terminals), python3 with python3-yaml (tests/tools/check_rosbag2.py, a reader
 # of those bags that shares no code with the writer).
+# dpkg-dev (dpkg-shlibdeps) and file: CPack's Debian packages find their dependencies from the
+# executable's shared libraries (cmake/BeaconlocInstall.cmake, integration.StagedInstall).
 # openssl (scripts/deployment-keys.sh: a secured deployment's keys) and libssl-dev (dds/security.cpp
 # checks an enclave's certificates before Fast DDS does; Fast DDS's security plugins link it too).
 # fastdds-tools (fast-discovery-server) and iproute2 (ip netns): the multi-host tests, whose hosts

@@ -97,6 +97,11 @@ OptionSet& OptionSet::texts(std::string flag, std::vector<std::string>& values, 
   return *this;
 }
 
+OptionSet& OptionSet::options_of(const OptionSet& other) {
+  entries_.insert(entries_.end(), other.entries_.begin(), other.entries_.end());
+  return *this;
+}
+
 std::vector<CLI::Option*> OptionSet::add_to(CLI::App* app) const {
   std::vector<CLI::Option*> options;
   options.reserve(entries_.size());

@@ -39,6 +39,9 @@ class OptionSet {
   OptionSet& texts(std::string flag, std::vector<std::string>& values, std::string help,
                    Configure configure = {});
 
+  // Every option of `other` too, after these.
+  OptionSet& options_of(const OptionSet& other);
+
   // Adds every option to `app`, bound to its variable. Returns the options by flag order, for the
   // caller's constraints between them (excludes, ...).
   std::vector<CLI::Option*> add_to(CLI::App* app) const;

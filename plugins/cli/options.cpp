@@ -20,7 +20,14 @@ OptionSet dds_option_set(dds::DdsOptions& o) {
              [](CLI::Option* option) { option->check(CLI::ExistingFile); })
       .text("--keystore", o.security.keystore,
             "DDS Security on: the deployment's keystore (scripts/deployment-keys.sh; SROS2 layout)",
-            [](CLI::Option* option) { option->check(CLI::ExistingDirectory); })
+            [](CLI::Option* option) {
+              // An empty value (`--keystore=`, `keystore: ""` in a configuration file) is no
+              // keystore: refused, never taken for "unsecured".
+              option->check(CLI::Validator(
+                  [](std::string& dir) { return dir.empty() ? std::string("no directory given") : std::string(); },
+                  "DIR"));
+              option->check(CLI::ExistingDirectory);
+            })
       .text("--enclave", o.security.enclave,
             "the participant's identity in the keystore (default: its role's, e.g. /beaconloc/decoder; "
             "not with run or demo, whose participants each take their own)");
@@ -80,10 +87,20 @@ OptionSet decoder_option_set(TofDecoderConfig& o, double& max_age_ms) {
   return set;
 }
 
+OptionSet estimator_plugin_option_set(std::vector<std::string>& plugins) {
+  OptionSet set;
+  set.texts("--estimator-plugin", plugins,
+            "load estimators built out of tree from this plugin file, or every *.so of this directory "
+            "(repeatable; docs/deployment.md)",
+            [](CLI::Option* option) { option->check(CLI::ExistingPath); });
+  return set;
+}
+
 OptionSet localizer_option_set(LocalizerSettings& o, bool standalone) {
   OptionSet set;
   set.text("--estimator", o.estimator, "estimator plugin (see beaconloc localizer --list-estimators)", {},
            OptionSet::Written::kAlways)
+      .options_of(estimator_plugin_option_set(o.estimator_plugins))
       .text("--receivers", o.receivers, "receivers in the robot frame, x:y[,x:y...] (m)")
       .texts("--param", o.parameters, "estimator parameter NAME=VALUE (repeatable)")
       .text("--map", o.map_file,

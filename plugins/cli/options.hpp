@@ -3,6 +3,8 @@
 // (commands/*.cpp) add them, `run --processes` writes them back as its children's command lines.
 #include <cstdint>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "option_set.hpp"
 #include "pipeline.hpp"
@@ -18,7 +20,10 @@ OptionSet gateway_option_set(GatewayOptions& o, std::optional<std::uint64_t>& se
 // --min-range-m, --max-range-m, --range-sigma-m, --range-scale, --max-age-ms (max_age_ns is set
 // from max_age_ms after parsing: decoder_config_with_age)
 OptionSet decoder_option_set(TofDecoderConfig& o, double& max_age_ms);
-// --estimator, --receivers, --param, --map, --initial-pose; standalone (the localizer command,
+// --estimator-plugin (localizer/estimator_plugins.hpp): in localizer_option_set, and alone for the
+// commands that make estimators without DDS (accuracy)
+OptionSet estimator_plugin_option_set(std::vector<std::string>& plugins);
+// --estimator, --estimator-plugin, --receivers, --param, --map, --initial-pose; standalone (the localizer command,
 // not demo or run, whose source gives the receivers and names the robot): also --robot,
 // --receiver-radius-m, --receiver-count, --receiver-height-m.
 OptionSet localizer_option_set(LocalizerSettings& o, bool standalone);

@@ -23,6 +23,7 @@
 #include "beaconloc/dds/stop_signal.hpp"
 #include "decoder_participant.hpp"
 #include "diagnostics_recorder.hpp"
+#include "estimator_plugins.hpp"
 #include "estimator_state_recorder.hpp"
 #include "lead_limiter.hpp"
 #include "offline_run.hpp"
@@ -612,6 +613,9 @@ std::vector<std::string> LocalizerSettings::arguments(const std::optional<Receiv
 PipelineResult run_pipeline(const PipelineOptions& options, LoadedSource source,
                             const std::string& self_exe) {
   if (!options.out_dir.empty()) std::filesystem::create_directories(options.out_dir);
+  // Here too with --processes (the localizer process loads them again): a bad plugin is refused
+  // before any participant starts.
+  load_estimator_plugins(options.localizer.estimator_plugins);
   return options.processes ? run_in_processes(options, std::move(source), self_exe)
                            : run_in_one_process(options, std::move(source));
 }

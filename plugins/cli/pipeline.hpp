@@ -40,6 +40,9 @@ LoadedSource load_source(const SourceChoice& choice, std::optional<std::uint64_t
 
 struct LocalizerSettings {
   std::string estimator = "range_ekf";
+  // Estimator plugins built out of tree (files, or directories of them), loaded before the estimator
+  // is made (localizer/estimator_plugins.hpp).
+  std::vector<std::string> estimator_plugins;
   std::string robot;                    // empty: every robot
   std::vector<std::string> parameters;  // NAME=VALUE
   // Receivers in the robot frame, "x:y,x:y,...": empty for a circle of receiver_count at

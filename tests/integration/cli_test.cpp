@@ -44,12 +44,18 @@ TEST(Cli, NoSubcommandIsAnError) {
 
 struct BadInvocation {
   std::vector<std::string> args;
-  const char* must_name;
+  std::string must_name;
 };
 
 TEST(Cli, BadArgumentsAndConfigurationNameTheCulpritAndFail) {
   const std::string bad_xml = "/tmp/beaconloc-cli-bad-qos.xml";
   std::ofstream(bad_xml) << "<dds><profiles><participant profile_name=\"x\"><rtps>\n";
+  // Configuration files (cli/config_file.hpp): a key that is no option of its section's command,
+  // and a value the option refuses, as on the command line.
+  const std::string bad_config = "/tmp/beaconloc-cli-bad-config.yaml";
+  std::ofstream(bad_config) << "localizer:\n  ros__parameters:\n    estimater: range_ekf\n";
+  const std::string bad_value = "/tmp/beaconloc-cli-bad-value.yaml";
+  std::ofstream(bad_value) << "/**:\n  ros__parameters:\n    domain: 999\n";
   const std::vector<BadInvocation> cases = {
       {{"gateway", "--speed", "-1"}, "--speed"},
       {{"gateway", "--speed", "fast"}, "--speed"},
@@ -62,9 +68,13 @@ TEST(Cli, BadArgumentsAndConfigurationNameTheCulpritAndFail) {
       {{"localizer", "--param", "nis_gate"}, "--param"},
       {{"localizer", "--param", "nis_gate=abc"}, "--param"},
       {{"localizer", "--qos", "/nonexistent/qos.xml"}, "/nonexistent/qos.xml"},
-      {{"localizer", "--qos", bad_xml}, bad_xml.c_str()},
+      {{"localizer", "--qos", bad_xml}, bad_xml},
       {{"decoder", "--participant-profile", "no.such.profile"}, "no.such.profile"},
       {{"gateway", "--no-such-flag"}, "--no-such-flag"},
+      {{"decoder", "--config", bad_config}, "'localizer.estimater': localizer has no option --estimater"},
+      {{"decoder", "--config", bad_value}, "--domain"},
+      {{"decoder", "--keystore="}, "--keystore"},
+      {{"localizer", "--estimator-plugin", bad_xml}, "estimator plugin " + bad_xml + ": cannot be loaded"},
   };
   for (const auto& c : cases) {
     auto [code, out] = beaconloc(c.args);
@@ -74,6 +84,8 @@ TEST(Cli, BadArgumentsAndConfigurationNameTheCulpritAndFail) {
     EXPECT_NE(out.find(c.must_name), std::string::npos) << joined << "\n" << out;
   }
   std::remove(bad_xml.c_str());
+  std::remove(bad_config.c_str());
+  std::remove(bad_value.c_str());
 }
 
 // A mistyped or out-of-range --param stops every command that creates an estimator at start,

@@ -69,7 +69,7 @@ class Recording : public ::testing::Test {
     return run_command(beaconloc("run", args), 300s);
   }
   std::pair<int, std::string> replay(const std::string& recording, const std::string& out) {
-    std::vector<std::string> args{"--replay", recording, "--out", out};
+    std::vector<std::string> args{"--replay", recording, "--speed", "4", "--out", out};
     args.insert(args.end(), kReplaySettings.begin(), kReplaySettings.end());
     return run(args);
   }
@@ -83,7 +83,11 @@ class Recording : public ::testing::Test {
 };
 
 TEST_F(Recording, ARunsOwnRecordingReplaysToByteIdenticalEstimates) {
-  const auto [code, out] = run({"--duration-s", "8", "--seed", "3", "--out", path("live")});
+  // Paced at four times real time, live and replayed: flat out on a loaded machine (the whole
+  // suite on 2 cores, seen once), a sample can reach the localizer beyond its horizon in one run
+  // and not the other (refused and counted, core/out_of_sequence_fusion.hpp), and the estimates
+  // then differ for that reason, not the recording's.
+  const auto [code, out] = run({"--duration-s", "8", "--seed", "3", "--speed", "4", "--out", path("live")});
   ASSERT_EQ(code, 0) << out;
   const auto [replay_code, replay_out] = replay(path("live"), path("replayed"));
   ASSERT_EQ(replay_code, 0) << replay_out;

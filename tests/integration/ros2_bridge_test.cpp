@@ -347,5 +347,108 @@ INSTANTIATE_TEST_SUITE_P(BothStartOrders, CycloneRobot,
                                   (c.param.secured ? "Secured" : "");
                          });
 
+// Discovery between the bridge and a ROS 2 robot on Cyclone DDS, in both start orders (issue 22):
+// rmw_cyclonedds on localhost turns multicast off, takes the first free participant index (up
+// to 32) and listens for discovery on that index's port alone. The robot here runs kRosProcesses
+// ROS 2 processes (Cyclone peers), more than the 4 indices Fast DDS announces to by default: with
+// that default the fifth and sixth found the bridge only at their next periodic announcement,
+// 6.4 s after it started. Each process must match the bridge (its rt/odom writer to the bridge's
+// reader), receive its tf_static (reliable, transient local: the first sample a ROS 2 node gets)
+// and find the bridge as node /beaconloc_bridge_robot1 in ros_discovery_info, whose GIDs are
+// those of the bridge's rt/ endpoints discovery found. The times from the start of the second
+// side (the bridge; or each process) to the match and to the first sample are printed.
+class CycloneDiscovery : public ::testing::TestWithParam<bool> {};  // the bridge first?
+
+// What cyclone_ros2_peer --discovery-only prints, with the steady clock's ns, on each event.
+std::optional<std::int64_t> peer_event_steady_ns(const std::string& log, const std::string& event) {
+  const std::string prefix = "cyclone peer: " + event + " at steady_ns ";
+  const auto at = log.find(prefix);
+  if (at == std::string::npos) return std::nullopt;
+  return std::stoll(log.substr(at + prefix.size()));
+}
+
+TEST_P(CycloneDiscovery, EveryRosProcessFindsTheBridgeWithinTwoSeconds) {
+  const bool bridge_first = GetParam();
+  constexpr int kRosProcesses = 6;
+  // The issue's acceptance line. The span includes starting a process (exec, loading, creating
+  // the participant), which the sanitizers make several times slower: under them it is
+  // kTimeScale longer. Discovery's own timers (announcements every 1 s) are not slowed.
+  const double bound_s = 2.0 * kTimeScale;
+  // The second side starts this long after the first is up, past the first's initial burst of
+  // announcements (Fast DDS: 20 over 2 s; Cyclone: two at its start): the issue's delays were
+  // after it, where only periodic announcements go out.
+  constexpr auto kAfterTheBurst = 2500ms;
+  DomainLease domain;
+  char dir[] = "/tmp/beaconloc-cyclone-discovery-XXXXXX";
+  ASSERT_NE(::mkdtemp(dir), nullptr);
+  const std::string d = dir;
+  const std::string domain_id = std::to_string(domain.id());
+  const auto steady_ns = [] {
+    return static_cast<std::int64_t>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+            .count());
+  };
+  std::unique_ptr<ChildProcess> bridge;
+  std::int64_t bridge_started_ns = 0;
+  auto start_bridge = [&] {
+    bridge_started_ns = steady_ns();
+    bridge = std::make_unique<ChildProcess>(
+        std::vector<std::string>{BEACONLOC_EXECUTABLE, "bridge", "--domain", domain_id, "--participant-profile",
+                                 "beaconloc.loopback_interop", "--odom-in", "--receivers", "0:0"},
+        d + "/bridge.log");
+  };
+  std::vector<std::unique_ptr<ChildProcess>> ros;
+  std::vector<std::int64_t> ros_started_ns;
+  auto start_ros_processes = [&] {
+    for (int i = 0; i < kRosProcesses; ++i) {
+      ros_started_ns.push_back(steady_ns());
+      ros.push_back(std::make_unique<ChildProcess>(
+          std::vector<std::string>{CYCLONE_ROS2_PEER, "--domain", domain_id, "--seconds",
+                                   std::to_string(30 * kTimeScale), "--discovery-only", "1", "--expect-node",
+                                   "/beaconloc_bridge_robot1"},
+          d + "/ros" + std::to_string(i) + ".log"));
+    }
+  };
+  if (bridge_first) {
+    dds::DdsOptions dds;
+    dds.domain_id = domain.id();
+    DiagnosticsRecorder diagnostics(dds);
+    start_bridge();
+    ASSERT_TRUE(wait_until_reporting(diagnostics, {"beaconloc.bridge.robot1"})) << bridge->log();
+    std::this_thread::sleep_for(kAfterTheBurst);
+    start_ros_processes();
+  } else {
+    start_ros_processes();
+    for (const auto& p : ros) {
+      ASSERT_TRUE(eventually([&] { return p->log().find(kPeerWritersUp) != std::string::npos; }, 20s)) << p->log();
+    }
+    std::this_thread::sleep_for(kAfterTheBurst);
+    start_bridge();
+  }
+  for (int i = 0; i < kRosProcesses; ++i) {
+    ChildProcess& p = *ros[static_cast<std::size_t>(i)];
+    EXPECT_EQ(p.wait(60s), 0) << p.log() << "\n--- bridge\n" << bridge->log();
+    const std::int64_t second_started_ns =
+        bridge_first ? ros_started_ns[static_cast<std::size_t>(i)] : bridge_started_ns;
+    const auto matched_ns = peer_event_steady_ns(p.log(), "matched the bridge");
+    const auto sample_ns = peer_event_steady_ns(p.log(), "first tf_static");
+    ASSERT_TRUE(matched_ns && sample_ns) << p.log();
+    const double matched_s = static_cast<double>(*matched_ns - second_started_ns) * 1e-9;
+    const double sample_s = static_cast<double>(*sample_ns - second_started_ns) * 1e-9;
+    std::printf("%s first: ROS 2 process %d matched %.3f s and got tf_static %.3f s after the %s started\n",
+                bridge_first ? "bridge" : "robot", i, matched_s, sample_s, bridge_first ? "process" : "bridge");
+    EXPECT_LT(matched_s, bound_s) << "ROS 2 process " << i;
+    EXPECT_LT(sample_s, bound_s) << "ROS 2 process " << i;
+  }
+  bridge->signal(SIGTERM);
+  EXPECT_EQ(bridge->wait(20s), 0) << bridge->log();
+  std::filesystem::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothStartOrders, CycloneDiscovery, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& c) {
+                           return std::string(c.param ? "BridgeFirst" : "RobotFirst");
+                         });
+
 }  // namespace
 }  // namespace beaconloc::testing

@@ -9,17 +9,25 @@
 // know. Prints "cyclone peer: writers up" once its endpoints exist. Exit 0 once every topic has
 // delivered a correct sample; 1, with the failures on stderr, at the first wrong field or when
 // --seconds run out.
+// --discovery-only 1: exit 0 as soon as the bridge is matched and its tf_static arrived (printing
+// both times on the steady clock), for the discovery-time test. --expect-node /NS/NAME: also
+// require ros_discovery_info to name that node with exactly the GIDs of the rt/ readers and
+// writers discovery found on its participant (what `ros2 topic info -v` shows).
 //   cyclone_ros2_peer --domain N --seconds S --beacons ID:X:Y:Z[,ID:X:Y:Z...] [--keystore DIR --enclave E]
+//                     [--discovery-only 1] [--expect-node /NS/NAME]
 // With --keystore, it joins with DDS Security as an SROS2 node does: the enclave's files of an
 // SROS2 keystore (scripts/deployment-keys.sh makes one) and Cyclone's security plugins
 // (CYCLONE_SECURITY_DIR: Debian ships them beside libddsc).
 #include <dds/dds.h>
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -69,11 +77,107 @@ dds_qos_t* qos(bool reliable, bool transient_local, int depth) {
   return q;
 }
 
+using Guid = std::array<unsigned char, 16>;
+
+Guid guid_of(const dds_guid_t& g) {
+  Guid out;
+  std::memcpy(out.data(), g.v, out.size());
+  return out;
+}
+
+// The GUIDs of the rt/ (ROS topic) endpoints of one participant that discovery has found so far,
+// from the built-in DCPSPublication or DCPSSubscription reader.
+std::set<Guid> ros_endpoints_of(dds_entity_t builtin_reader, const Guid& participant) {
+  std::set<Guid> out;
+  void* samples[128] = {nullptr};
+  dds_sample_info_t infos[128];
+  const int n = dds_read(builtin_reader, samples, infos, 128, 128);
+  for (int i = 0; i < n; ++i) {
+    const auto* e = static_cast<const dds_builtintopic_endpoint_t*>(samples[i]);
+    if (infos[i].valid_data && infos[i].instance_state == DDS_IST_ALIVE &&
+        guid_of(e->participant_key) == participant && std::strncmp(e->topic_name, "rt/", 3) == 0) {
+      out.insert(guid_of(e->key));
+    }
+  }
+  if (n > 0) dds_return_loan(builtin_reader, samples, n);
+  return out;
+}
+
+// Whether discovery found the participant of that GUID.
+// The user data of that participant as discovered (rmw's "enclave=<enclave>;"), or nullopt when it
+// was not discovered.
+std::optional<std::string> discovered_user_data(dds_entity_t participants_reader, const Guid& participant) {
+  std::optional<std::string> found;
+  void* samples[64] = {nullptr};
+  dds_sample_info_t infos[64];
+  const int n = dds_read(participants_reader, samples, infos, 64, 64);
+  for (int i = 0; i < n; ++i) {
+    const auto* p = static_cast<const dds_builtintopic_participant_t*>(samples[i]);
+    if (!infos[i].valid_data || guid_of(p->key) != participant) continue;
+    void* data = nullptr;
+    size_t size = 0;
+    found = dds_qget_userdata(p->qos, &data, &size) && data ? std::string(static_cast<const char*>(data), size)
+                                                            : std::string();
+    dds_free(data);
+  }
+  if (n > 0) dds_return_loan(participants_reader, samples, n);
+  return found;
+}
+
+// A GID of ros_discovery_info as the GUID it was formed from (Jazzy's Gid is the GUID itself).
+Guid guid_of(const rmw_dds_common_msg_dds__Gid_& gid) {
+  Guid out;
+  std::memcpy(out.data(), gid.data, out.size());
+  return out;
+}
+
+std::set<Guid> guids_of(const dds_sequence_rmw_dds_common_msg_dds__Gid_& gids) {
+  std::set<Guid> out;
+  for (uint32_t i = 0; i < gids._length; ++i) out.insert(guid_of(gids._buffer[i]));
+  return out;
+}
+
+// What `ros2 topic info -v` would say of the bridge: its node, as ros_discovery_info names it,
+// holds exactly the rt/ readers and writers discovery found on that participant, a participant
+// discovery found. Empty when all holds.
+struct NodeInGraph {
+  std::string ns, name;
+  bool seen = false;  // a ros_discovery_info sample naming the node arrived
+  Guid participant{};
+  std::set<Guid> readers, writers;
+};
+
+std::string graph_problem(const NodeInGraph& node, dds_entity_t publications, dds_entity_t subscriptions,
+                          dds_entity_t participants) {
+  if (!node.seen) return "no ros_discovery_info names node " + node.ns + " " + node.name;
+  const std::set<Guid> writers = ros_endpoints_of(publications, node.participant);
+  const std::set<Guid> readers = ros_endpoints_of(subscriptions, node.participant);
+  if (writers.empty() || writers != node.writers) {
+    return "ros_discovery_info lists " + std::to_string(node.writers.size()) + " writers of the node, discovery " +
+           "found " +
+           std::to_string(writers.size()) + " rt/ writers on its participant (or other GIDs)";
+  }
+  if (readers.empty() || readers != node.readers) {
+    return "ros_discovery_info lists " + std::to_string(node.readers.size()) + " readers of the node, discovery " +
+           "found " +
+           std::to_string(readers.size()) + " rt/ readers on its participant (or other GIDs)";
+  }
+  const std::optional<std::string> user_data = discovered_user_data(participants, node.participant);
+  if (!user_data) return "the node's participant (ros_discovery_info's gid) was not discovered";
+  // What rmw puts in a ROS 2 participant's user data, and ros2 tools read: its enclave.
+  if (user_data->rfind("enclave=", 0) != 0 || user_data->back() != ';') {
+    return "the node's participant has user data '" + *user_data + "', not rmw's enclave=<enclave>;";
+  }
+  return "";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int domain = 0;
   double seconds = 30.0;
+  bool discovery_only = false;
+  std::string expect_node;  // e.g. /beaconloc_bridge_robot1: the bridge must be that ROS 2 node
   std::string keystore, enclave;
   std::vector<Beacon> beacons;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -82,6 +186,8 @@ int main(int argc, char** argv) {
     if (key == "--seconds") seconds = std::atof(value.c_str());
     if (key == "--keystore") keystore = value;
     if (key == "--enclave") enclave = value;
+    if (key == "--discovery-only") discovery_only = value == "1";
+    if (key == "--expect-node") expect_node = value;
     if (key == "--beacons") {
       std::stringstream list(value);
       std::string item;
@@ -91,11 +197,12 @@ int main(int argc, char** argv) {
       }
     }
   }
-  // Loopback only, unicast discovery to 127.0.0.1 (ROS2-INTEROP.md: Cyclone on lo).
+  // Loopback only, unicast discovery to 127.0.0.1 (ROS2-INTEROP.md: Cyclone on lo), participant
+  // indices up to 32 as rmw_cyclonedds sets them for ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST.
   std::string config =
       "<CycloneDDS><Domain><General><Interfaces><NetworkInterface name=\"lo\" multicast=\"false\"/>"
       "</Interfaces></General><Discovery><Peers><Peer address=\"127.0.0.1\"/></Peers>"
-      "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>30</MaxAutoParticipantIndex>"
+      "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32</MaxAutoParticipantIndex>"
       "</Discovery>";
   if (!keystore.empty()) {
     // The files rmw_cyclonedds takes from ROS_SECURITY_KEYSTORE/enclaves/ROS_SECURITY_ENCLAVE.
@@ -145,8 +252,22 @@ int main(int argc, char** argv) {
       participant, topic(&tf2_msgs_msg_dds__TFMessage__desc, "rt/tf_static"), latched_qos, nullptr);
   const dds_entity_t beacons_reader = dds_create_reader(
       participant, topic(&visualization_msgs_msg_dds__MarkerArray__desc, "rt/beacons"), latched_qos, nullptr);
+  // The ROS 2 graph as `ros2 topic info -v` builds it: rmw's ros_discovery_info, and the endpoints
+  // and participants DDS discovery found (Cyclone's built-in topics).
+  dds_qos_t* graph_qos = qos(true, true, 1);
+  const dds_entity_t graph_reader = dds_create_reader(
+      participant, topic(&rmw_dds_common_msg_dds__ParticipantEntitiesInfo__desc, "ros_discovery_info"), graph_qos,
+      nullptr);
+  dds_delete_qos(graph_qos);
+  const dds_entity_t publications_reader =
+      dds_create_reader(participant, DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+  const dds_entity_t subscriptions_reader =
+      dds_create_reader(participant, DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr, nullptr);
+  const dds_entity_t participants_reader =
+      dds_create_reader(participant, DDS_BUILTIN_TOPIC_DCPSPARTICIPANT, nullptr, nullptr);
   if (odom_writer < 0 || scan_writer < 0 || pose_reader < 0 || tf_reader < 0 || beacons_reader < 0 ||
-      odometry_reader < 0 || tf_static_reader < 0) {
+      odometry_reader < 0 || tf_static_reader < 0 || graph_reader < 0 || publications_reader < 0 ||
+      subscriptions_reader < 0 || participants_reader < 0) {
     std::fprintf(stderr, "creating the endpoints failed\n");
     return 2;
   }
@@ -166,6 +287,22 @@ int main(int argc, char** argv) {
   double drive_from_s = 1e9;
   auto truth_x = [&](double t) { return std::min(x0 + v * std::max(0.0, t - drive_from_s), 3.0); };
   bool pose_ok = false, tf_ok = false, beacons_ok = false, odometry_ok = false, tf_static_ok = false;
+  // When the bridge was first matched (its rt/odom reader) and its tf_static first arrived, on
+  // the steady clock (CLOCK_MONOTONIC, the same in every process of the machine): a test compares
+  // them with when it started the second of the two processes.
+  long long matched_steady_ns = -1, tf_static_steady_ns = -1;
+  // The node --expect-node names ("/ns/name", or "/name" in the root namespace).
+  NodeInGraph expected_node;
+  expected_node.ns = expect_node.substr(0, expect_node.rfind('/'));
+  if (expected_node.ns.empty()) expected_node.ns = "/";
+  expected_node.name = expect_node.substr(expect_node.rfind('/') + 1);
+  bool graph_ok = false;
+  std::string graph_problem_now;
+  auto steady_ns = [] {
+    return static_cast<long long>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                      std::chrono::steady_clock::now().time_since_epoch())
+                                      .count());
+  };
   int pose_samples = 0, tf_samples = 0;
   Checks last;
   std::vector<float> ranges(kBeams);
@@ -178,6 +315,11 @@ int main(int argc, char** argv) {
       dds_get_publication_matched_status(odom_writer, &odom_matched);
       dds_get_publication_matched_status(scan_writer, &scan_matched);
       if (odom_matched.current_count > 0 && scan_matched.current_count > 0) drive_from_s = t + 3.0;
+      if (odom_matched.current_count > 0 && matched_steady_ns < 0) {
+        matched_steady_ns = steady_ns();
+        std::printf("cyclone peer: matched the bridge at steady_ns %lld\n", matched_steady_ns);
+        std::fflush(stdout);
+      }
     }
     const double x = truth_x(t);  // drives 2 m, then stands
     const double speed = t > drive_from_s && x < 3.0 ? v : 0.0;
@@ -342,13 +484,47 @@ int main(int argc, char** argv) {
         c.expect(tr.transform.translation.x == 0.0 && tr.transform.translation.y == 0.0 &&
                      tr.transform.rotation.w == 1.0,
                  "tf_static: the receiver at the base's centre");
+        // Stamped with the time it was published (static_transform_publisher's now()), not 0:
+        // within this run's minute of the wall clock.
+        const double stamp_s = tr.header.stamp.sec + 1e-9 * tr.header.stamp.nanosec;
+        const double now_s =
+            std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+        c.expect(stamp_s > 0.0 && std::abs(now_s - stamp_s) < 60.0, "tf_static: stamped with the current time");
       }
       if (c.failures.empty()) tf_static_ok = true;
+      if (tf_static_steady_ns < 0) {
+        tf_static_steady_ns = steady_ns();
+        std::printf("cyclone peer: first tf_static at steady_ns %lld\n", tf_static_steady_ns);
+        std::fflush(stdout);
+      }
       last.failures.insert(last.failures.end(), c.failures.begin(), c.failures.end());
     }
     if (n > 0) dds_return_loan(tf_static_reader, samples, n);
     if (!last.failures.empty()) break;  // any sample with a wrong field fails the run
-    if (pose_ok && tf_ok && beacons_ok && odometry_ok && tf_static_ok) {
+    n = dds_take(graph_reader, samples, infos, 8, 8);
+    for (int i = 0; i < n; ++i) {
+      if (!infos[i].valid_data) continue;
+      const auto* m = static_cast<rmw_dds_common_msg_dds__ParticipantEntitiesInfo_*>(samples[i]);
+      for (uint32_t k = 0; k < m->node_entities_info_seq._length; ++k) {
+        const auto& info = m->node_entities_info_seq._buffer[k];
+        if (expected_node.ns != info.node_namespace || expected_node.name != info.node_name) continue;
+        expected_node.seen = true;
+        expected_node.participant = guid_of(m->gid);
+        expected_node.readers = guids_of(info.reader_gid_seq);
+        expected_node.writers = guids_of(info.writer_gid_seq);
+      }
+    }
+    if (n > 0) dds_return_loan(graph_reader, samples, n);
+    if (!expect_node.empty() && !graph_ok) {
+      graph_problem_now = graph_problem(expected_node, publications_reader, subscriptions_reader, participants_reader);
+      graph_ok = graph_problem_now.empty();
+    }
+    if (discovery_only && matched_steady_ns >= 0 && tf_static_ok && (expect_node.empty() || graph_ok)) {
+      std::printf("cyclone peer: discovered the bridge after %.2f s of its own\n", t);
+      dds_delete(participant);
+      return 0;
+    }
+    if (pose_ok && tf_ok && beacons_ok && odometry_ok && tf_static_ok && (expect_node.empty() || graph_ok)) {
       std::printf(
           "cyclone peer: %d beacon_pose and %d tf samples, beacons, odometry/beacons and tf_static "
           "received and checked after %.1f s\n",
@@ -360,6 +536,7 @@ int main(int argc, char** argv) {
   }
   std::fprintf(stderr, "cyclone peer: pose %d, tf %d, beacons %d, odometry %d, tf_static %d; failures:\n",
                pose_ok, tf_ok, beacons_ok, odometry_ok, tf_static_ok);
+  if (!expect_node.empty() && !graph_ok) std::fprintf(stderr, "  ROS 2 graph: %s\n", graph_problem_now.c_str());
   for (std::size_t i = 0; i < last.failures.size() && i < 20; ++i)
     std::fprintf(stderr, "  %s\n", last.failures[i].c_str());
   dds_delete(participant);

@@ -505,22 +505,58 @@ def check(args):
     return problems, topics, by_topic
 
 
+# A twist the bridge has not heard yet (no wheel odometry before the pose): (0, 0), a variance
+# this large on the diagonal (bridge/odom_frame.hpp kUnknownTwistVariance), never a certain one.
+UNKNOWN_TWIST_VARIANCE = 1e6
+TWIST_VX, TWIST_WZ = 0, 5  # rows of the twist covariance: vx, vy, vz, wx, wy, wz
+
+
+def twist_covariance(right_var, cross, left_var, base):
+    """Cov(v, omega) of wheel speeds with covariance [[right_var, cross], [cross, left_var]], through
+    v = (right + left) / 2, omega = (right - left) / base, as (var_v, cov_v_omega, var_omega): J C J^T
+    with J = [[1/2, 1/2], [1/base, -1/base]], multiplied out by hand."""
+    return ((right_var + 2.0 * cross + left_var) / 4.0, (right_var - left_var) / (2.0 * base),
+            (right_var - 2.0 * cross + left_var) / (base * base))
+
+
 def check_twists(path, decoded, problems):
     """Each Odometry message's twist is one the robot's wheels reported: (v, omega) =
     ((right + left) / 2, (right - left) / wheel_base) of a row of a recording's odometry.csv, the
-    other components 0 (a planar robot). Which row depends on when the pose met the odometry."""
-    reported = set()
+    other components 0 (a planar robot), and its covariance that row's wheel covariance carried to
+    (v, omega) at (vx, wz), 0 elsewhere; or, before any wheel row reached the bridge, (0, 0) with
+    the unknown variance. Which row depends on when the pose met the odometry."""
+    reported = {}
     with open(path, newline="", encoding="utf-8") as f:
         for line in csv.DictReader(f):
             right, left = float(line["wheel_velocity_right_mps"]), float(line["wheel_velocity_left_mps"])
             base = float(line["wheel_base_m"])
-            reported.add((float_bits((right + left) / 2.0), float_bits((right - left) / base)))
-    bad = [m for m in decoded
-           if (float_bits(m["vx"]), float_bits(m["wz"])) not in reported or
-           any(m[k] != 0.0 for k in ("vy", "vz", "wx", "wy"))]
+            key = (float_bits((right + left) / 2.0), float_bits((right - left) / base))
+            reported.setdefault(key, []).append(twist_covariance(
+                float(line["var_right"]), float(line["cov_right_left"]), float(line["var_left"]), base))
+
+    def block(m):
+        return (m["twist_cov%d" % (TWIST_VX * 6 + TWIST_VX)], m["twist_cov%d" % (TWIST_VX * 6 + TWIST_WZ)],
+                m["twist_cov%d" % (TWIST_WZ * 6 + TWIST_WZ)])
+
+    def fits(m):
+        if any(m[k] != 0.0 for k in ("vy", "vz", "wx", "wy")):
+            return False
+        if m["twist_cov%d" % (TWIST_VX * 6 + TWIST_WZ)] != m["twist_cov%d" % (TWIST_WZ * 6 + TWIST_VX)]:
+            return False
+        inside = {TWIST_VX * 6 + TWIST_VX, TWIST_VX * 6 + TWIST_WZ, TWIST_WZ * 6 + TWIST_VX, TWIST_WZ * 6 + TWIST_WZ}
+        if any(m["twist_cov%d" % i] != 0.0 for i in range(36) if i not in inside):
+            return False
+        if (m["vx"], m["wz"]) == (0.0, 0.0) and block(m) == (UNKNOWN_TWIST_VARIANCE, 0.0, UNKNOWN_TWIST_VARIANCE):
+            return True
+        candidates = reported.get((float_bits(m["vx"]), float_bits(m["wz"])), [])
+        # Bit for bit: the bridge computes the same expressions in the same order (odom_frame.cpp).
+        return any(tuple(float_bits(v) for v in block(m)) == tuple(float_bits(v) for v in c) for c in candidates)
+
+    bad = [m for m in decoded if not fits(m)]
     for m in bad[:MAX_REPORTED]:
-        problems.add("%s: odometry at stamp %d has twist (%r, %r, %r; %r, %r, %r), no wheel row reported it"
-                     % (path, m["stamp_ns"], m["vx"], m["vy"], m["vz"], m["wx"], m["wy"], m["wz"]))
+        problems.add("%s: odometry at stamp %d has twist (%r, %r, %r; %r, %r, %r) with covariance (%r, %r, %r) at"
+                     " (vx, wz), no wheel row reported it"
+                     % ((path, m["stamp_ns"], m["vx"], m["vy"], m["vz"], m["wx"], m["wy"], m["wz"]) + block(m)))
 
 
 def main(argv):

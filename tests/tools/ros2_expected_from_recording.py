@@ -4,9 +4,9 @@
 rotation about z), not from the bridge's code: for each row of a `beaconloc record` estimate.csv
 (robot_id, stamp_ns, x_m, y_m, yaw_rad, cov_00..cov_22 over x, y, yaw), the fields of its
 geometry_msgs/PoseWithCovarianceStamped and of its nav_msgs/Odometry, as CSVs for
-check_rosbag2.py --expect-poses / --expect-odometry. The odometry's twist is left unchecked (empty
-cells): it is the wheels' newest report when the pose arrived (check_rosbag2.py
---twists-from-wheels checks it); its covariance is expected all zeros (the bridge states none).
+check_rosbag2.py --expect-poses / --expect-odometry. The odometry's twist and its covariance are
+left unchecked here (empty cells): they are the wheels' newest report when the pose arrived
+(check_rosbag2.py --twists-from-wheels checks both against the recording's wheel rows).
 
     ros2_expected_from_recording.py ESTIMATE_CSV POSES_OUT ODOMETRY_OUT [--map-frame map] [--base-frame base_link]
 """
@@ -51,9 +51,8 @@ def main(argv):
             cov = covariance36(row)
             stamp = int(row["stamp_ns"])
             poses.writerow([stamp, args.map_frame] + [repr(v) for v in pose + cov])
-            # The twist's covariance: none is given (all zeros) until the bridge states one.
             odometry.writerow([stamp, args.map_frame, args.base_frame] + [repr(v) for v in pose] + [""] * 6 +
-                              [repr(v) for v in cov] + [repr(0.0)] * 36)
+                              [repr(v) for v in cov] + [""] * 36)
             rows += 1
     if rows == 0:
         print("ros2_expected_from_recording: no pose in %s" % args.estimate_csv, file=sys.stderr)

@@ -89,6 +89,28 @@ TEST(Ros2Bridge, DriverOdometryBecomesWheelSpeedsAndBadOnesAreRefused) {
                2 * o->wheel_velocity_covariance(0, 1)) /
                   4.0,
               0.01, 1e-12);
+  // A cross term of v and omega goes to the wheels, exactly symmetric (for every valid one: the
+  // localizer refuses an asymmetric covariance).
+  for (const double cross : {0.005, -0.013, 1e-3 / 3.0, 0.019}) {
+    m.twist().covariance()[5] = m.twist().covariance()[30] = cross;
+    const auto with_cross = from_ros_odometry(m, 0.4, &why);
+    ASSERT_TRUE(with_cross) << cross << " " << why;
+    EXPECT_EQ(with_cross->wheel_velocity_covariance(0, 1), with_cross->wheel_velocity_covariance(1, 0)) << cross;
+  }
+  // A covariance that is no covariance (asymmetric, negative, not positive semi-definite) is
+  // refused, not repaired.
+  m.twist().covariance()[5] = 0.001;
+  m.twist().covariance()[30] = 0.002;
+  EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
+  EXPECT_EQ(why, "bad_twist_covariance");
+  m.twist().covariance()[5] = m.twist().covariance()[30] = 0.05;  // 0.05^2 > 0.01 * 0.04
+  EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
+  EXPECT_EQ(why, "invalid_odometry_covariance");
+  m.twist().covariance()[5] = m.twist().covariance()[30] = 0.0;
+  m.twist().covariance()[35] = -0.04;
+  EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
+  EXPECT_EQ(why, "bad_twist_covariance");
+  m.twist().covariance()[35] = 0.04;
   m.twist().twist().linear().x(std::nan(""));
   EXPECT_FALSE(from_ros_odometry(m, 0.4, &why));
   EXPECT_EQ(why, "non_finite_twist");
@@ -161,6 +183,44 @@ TEST(Ros2Bridge, MapToOdomComposesToTheEstimate) {
   EXPECT_TRUE(odom.pose_odom_base(995'000'000)->isApprox(0.5 * (a + b), 1e-12));
   // Outside the history: none.
   EXPECT_FALSE(odom.pose_odom_base(2'000'000'000));
+}
+
+// odometry/beacons states what the wheels support: their reported covariance carried to (v, omega)
+// (v = (v_R + v_L) / 2, omega = (v_R - v_L) / B), at (vx, wz) of the 6x6; before any odometry, a
+// twist not known (a large variance), never a certain standstill; a driver's own covariance as given.
+TEST(Ros2Bridge, TheOdometrysTwistCovarianceIsTheWheelsCarriedToVAndOmega) {
+  OdomFrame odom;
+  EXPECT_EQ(odom.twist_covariance(), OdomFrame::kUnknownTwistVariance * Eigen::Matrix2d::Identity());
+  OdometrySample o;
+  o.wheel_base_m = 0.5;
+  o.wheel_velocity_right_mps = 0.3;
+  o.wheel_velocity_left_mps = 0.1;
+  o.wheel_velocity_covariance << 4e-4, 1e-4, 1e-4, 9e-4;
+  ASSERT_TRUE(odom.add_wheel_odometry(o).accepted);
+  // By hand: var_v = (4 + 2 + 9) e-4 / 4; cov = (4 - 9) e-4 / (2 B); var_w = (4 - 2 + 9) e-4 / B^2.
+  const Eigen::Matrix2d& c = odom.twist_covariance();
+  EXPECT_NEAR(c(0, 0), 15e-4 / 4.0, 1e-15);
+  EXPECT_NEAR(c(0, 1), -5e-4 / 1.0, 1e-15);
+  EXPECT_EQ(c(1, 0), c(0, 1));  // exactly: a covariance on the wire is symmetric
+  EXPECT_NEAR(c(1, 1), 11e-4 / 0.25, 1e-15);
+
+  PoseEstimate e;
+  e.stamp_ns = 1;
+  const nav_msgs::msg::Odometry m = to_ros_odometry(e, odom.v_mps(), odom.omega_radps(), c, "map", "base_link");
+  EXPECT_EQ(m.twist().twist().linear().x(), 0.2);
+  EXPECT_EQ(ros_twist_covariance(m), c);
+  for (int i = 0; i < 36; ++i) {
+    if (i != 0 && i != 5 && i != 30 && i != 35) {
+      EXPECT_EQ(m.twist().covariance()[i], 0.0) << i;
+    }
+  }
+  // A driver feeding the frame (--odom-in): its own covariance.
+  Eigen::Matrix2d driver;
+  driver << 0.01, 0.0, 0.0, 0.04;
+  ASSERT_TRUE(odom.add_odom_pose(2'000'000'000, Pose2(1.0, 0.0, 0.0), 0.5, 0.2, driver));
+  EXPECT_EQ(odom.twist_covariance(), driver);
+  EXPECT_FALSE(odom.add_odom_pose(3'000'000'000, Pose2(1.0, 0.0, 0.0), 0.5, 0.2,
+                                  Eigen::Matrix2d::Constant(std::nan(""))));
 }
 
 // A clock that steps forward (a gateway stamping data time replaced by one stamping wall-clock

@@ -6,8 +6,10 @@
 
 #include "beaconloc/core/limits.hpp"
 #include "command.hpp"
+#include "estimator_plugins.hpp"
 #include "number_options.hpp"
 #include "offline_run.hpp"
+#include "options.hpp"
 #include "pipeline.hpp"
 #include "sim/faults.hpp"
 #include "sim/scenario_yaml.hpp"
@@ -54,6 +56,7 @@ class AccuracyCommand : public Command {
             "accuracy over seeds, without DDS: a markdown table of mean and spread per scenario and estimator")) {
     app_->add_option("--scenario", scenarios_, "scenario YAML (repeatable)")->required()->check(CLI::ExistingFile);
     app_->add_option("--estimator", estimators_, "estimator (repeatable; default range_ekf)");
+    estimator_plugin_option_set(estimator_plugins_).add_to(app_);
     app_->add_option("--seeds", seeds_, "number of seeds")->transform(whole_in(1, 1000));
     app_->add_option("--first-seed", first_seed_, "first seed")->transform(any_unsigned());
     app_->add_option("--settle-s", settle_s_, "seconds after the first pose not scored")
@@ -81,6 +84,7 @@ class AccuracyCommand : public Command {
   }
   bool runs_participants() const override { return false; }
   int execute() override {
+    load_estimator_plugins(estimator_plugins_);
     std::vector<AccuracyRow> rows;
     std::vector<std::string> failed_runs;
     const bool variants_compared = !faults_.empty() || delay_ms_ > 0.0;
@@ -176,7 +180,7 @@ class AccuracyCommand : public Command {
     return row;
   }
 
-  std::vector<std::string> scenarios_, estimators_{"range_ekf"}, parameters_, faults_;
+  std::vector<std::string> scenarios_, estimators_{"range_ekf"}, estimator_plugins_, parameters_, faults_;
   int seeds_ = 10;
   std::uint64_t first_seed_ = 1;
   double settle_s_ = 0.0;

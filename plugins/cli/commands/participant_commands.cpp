@@ -11,6 +11,7 @@
 #include "bridge_participant.hpp"
 #include "command.hpp"
 #include "decoder_participant.hpp"
+#include "estimator_plugins.hpp"
 #include "localizer_participant.hpp"
 #include "monitor.hpp"
 #include "number_options.hpp"
@@ -122,6 +123,7 @@ class LocalizerCommand : public Command {
                    "the live shards of its estimator, take over a dead shard's robots");
   }
   int execute() override {
+    load_estimator_plugins(settings_.estimator_plugins);
     if (list_estimators_) {
       for (const auto& name : EstimatorRegistry::instance().names()) {
         std::cout << name << "  " << EstimatorRegistry::instance().description(name) << '\n';

@@ -7,6 +7,7 @@
 // shortest form that reads back to the same double (std::to_chars), and every row with one
 // write(2), so that a recording cut by a kill ends with a whole row. DDS-free.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -40,6 +41,15 @@ inline constexpr const char* kTruthHeader = "stamp_ns,x_m,y_m,yaw_rad";
 // The simulator's hidden truth about a TOF or pulse (who fired; an echo or not), for evaluation
 // only: extra columns a replay ignores.
 inline constexpr const char* kHiddenTruthColumns = ",true_beacon_id,echo";
+
+// A pulse's mark as recordings write it (to_string(PulseMark): pulse.csv here, pulses.csv of the
+// dataset layout), read back; nullopt for any other text.
+inline std::optional<PulseMark> parse_pulse_mark(std::string_view name) {
+  for (const PulseMark m : {PulseMark::kNotReported, PulseMark::kSingle, PulseMark::kDouble}) {
+    if (name == to_string(m)) return m;
+  }
+  return std::nullopt;
+}
 }  // namespace bus_recording
 
 // A file written one whole line per write(2) (O_APPEND): a kill leaves whole lines only. Throws

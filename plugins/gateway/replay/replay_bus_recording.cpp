@@ -149,14 +149,9 @@ void ReplaySource::load_bus_pulses(const std::string& path) {
       continue;
     }
     const std::string& mark = csv.cell("mark");
-    PulseMark parsed = PulseMark::kNotReported;
-    if (mark == to_string(PulseMark::kSingle)) {
-      parsed = PulseMark::kSingle;
-    } else if (mark == to_string(PulseMark::kDouble)) {
-      parsed = PulseMark::kDouble;
-    } else if (mark != to_string(PulseMark::kNotReported)) {
-      refuse("pulse", csv.line(), "invalid_mark",
-             "mark '" + mark + "' is not single, double or not_reported");
+    const std::optional<PulseMark> parsed = bus_recording::parse_pulse_mark(mark);
+    if (!parsed) {
+      refuse("pulse", csv.line(), "invalid_mark", "mark '" + mark + "' is not single, double or not_reported");
       continue;
     }
     SourceEvent e;
@@ -164,7 +159,7 @@ void ReplaySource::load_bus_pulses(const std::string& path) {
     e.stamp_ns = stamp;
     e.pulse.stamp_ns = stamp;
     e.pulse.receiver_id = static_cast<std::uint32_t>(receiver);
-    e.pulse.mark = parsed;
+    e.pulse.mark = *parsed;
     e.pulse.sequence_number = static_cast<std::uint64_t>(sequence);
     events_.push_back(e);
   }

@@ -255,12 +255,8 @@ void ReplaySource::load_pulses(const std::string& path) {
     double t = 0;
     if (!complete(csv, "pulses") || !take(csv, "pulses", "t_s", t, 0.0, kMaxFileStampS)) continue;
     const std::string mark = csv.cell("mark");
-    PulseMark parsed = PulseMark::kNotReported;
-    if (mark == to_string(PulseMark::kSingle)) {
-      parsed = PulseMark::kSingle;
-    } else if (mark == to_string(PulseMark::kDouble)) {
-      parsed = PulseMark::kDouble;
-    } else if (mark != to_string(PulseMark::kNotReported)) {
+    const std::optional<PulseMark> parsed = bus_recording::parse_pulse_mark(mark);
+    if (!parsed) {
       refuse("pulses", csv.line(), "invalid_mark", "mark '" + mark + "' is not single, double or not_reported");
       continue;
     }
@@ -272,7 +268,7 @@ void ReplaySource::load_pulses(const std::string& path) {
     e.stamp_ns = arrival_ns;
     e.pulse.stamp_ns = arrival_ns;
     e.pulse.receiver_id = 0;  // one receiver at the robot's centre (receivers())
-    e.pulse.mark = parsed;
+    e.pulse.mark = *parsed;
     e.pulse.sequence_number = sequence++;
     events_.push_back(e);
   }

@@ -173,7 +173,7 @@ void SerialSource::push(const SourceEvent& e) {
   // A gateway that stopped taking must not make the reader grow without bound: beyond
   // kMaxPending the oldest go, counted.
   if (pending_.size() >= kMaxPending) {
-    pending_.erase(pending_.begin());
+    pending_.pop_front();
     counts_.reject("serial.backlog_dropped");
   }
   pending_.push_back(e);

@@ -14,6 +14,7 @@
 // gateway's Diagnostics as source.serial.<reason>). Live: the source never ends. DDS-free.
 #include <atomic>
 #include <chrono>
+#include <deque>
 #include <functional>
 #include <mutex>
 #include <string>
@@ -84,7 +85,7 @@ class SerialSource final : public Source {
   mutable std::mutex mutex_;
   serial::FrameParser parser_;
   serial::DeviceClock clock_;
-  std::vector<SourceEvent> pending_;
+  std::deque<SourceEvent> pending_;  // the oldest dropped first when full (push)
   std::uint64_t sequence_ = 0;
   StampNs previous_odometry_ns_ = -1;  // the mapped stamp of the line's previous odometry frame
   std::uint64_t clock_resets_seen_ = 0;

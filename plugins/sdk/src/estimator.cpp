@@ -215,6 +215,11 @@ std::string EstimatorRegistry::reference_scenario(const std::string& name) const
   return it == entries_.end() ? std::string() : it->second.reference_scenario;
 }
 
+EstimatorFactory EstimatorRegistry::factory(const std::string& name) const {
+  auto it = entries_.find(name);
+  return it == entries_.end() ? EstimatorFactory() : it->second.factory;
+}
+
 InputResult check_initial_pose(const Pose2& pose, const Cov3& c) {
   if (!pose.allFinite() || !c.allFinite() || !c.isApprox(c.transpose(), 1e-9) ||
       Eigen::LLT<Cov3>(c).info() != Eigen::Success) {

@@ -154,6 +154,11 @@ Participant::Participant(const DdsOptions& options, const std::string& name) : n
     enable_security(check_enclave(options.security, enclave, static_cast<std::int64_t>(std::time(nullptr))), qos);
     secured_ = true;
   }
+  // What rmw puts in a ROS 2 participant's user data and ROS 2 tools read (ros2 node list, the
+  // bridge's ros_discovery_info): the participant's security enclave, "/" when unsecured. It
+  // replaces any <userData> of the participant profile (ours set none).
+  const std::string user_data = "enclave=" + (enclave.empty() ? std::string("/") : enclave) + ";";
+  qos.user_data().data_vec(std::vector<eprosima::fastrtps::rtps::octet>(user_data.begin(), user_data.end()));
   // Only the discovery of publishers is listened to (WriterRobots): the entities' statuses go to
   // their own listeners.
   participant_ = factory->create_participant(options.domain_id, qos, &writer_robots_, StatusMask::none());

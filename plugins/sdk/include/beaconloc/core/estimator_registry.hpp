@@ -33,6 +33,9 @@ class EstimatorRegistry {
   std::vector<std::string> names() const;
   std::string description(const std::string& name) const;
   std::string reference_scenario(const std::string& name) const;
+  // The factory registered under `name`; empty when none is (estimator_plugins: a plugin's
+  // estimators are added to the localizer's registry through it).
+  EstimatorFactory factory(const std::string& name) const;
 
  private:
   struct Entry {
