@@ -4,7 +4,9 @@
 #include "config_file.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <cstdio>
 #include <fstream>
 
 namespace beaconloc::cli {
@@ -61,9 +63,20 @@ struct Commands {
   }
 };
 
+// The configuration files a test writes, removed when the test program ends.
+struct ScratchFiles {
+  std::vector<std::string> paths;
+  ~ScratchFiles() {
+    for (const std::string& path : paths) std::remove(path.c_str());
+  }
+};
+ScratchFiles scratch_files;
+
 std::string config_file(const std::string& name, const std::string& yaml) {
-  const std::string path = ::testing::TempDir() + "/" + name + ".yaml";
+  const std::string path =
+      ::testing::TempDir() + "/beaconloc-config-" + std::to_string(::getpid()) + "-" + name + ".yaml";
   std::ofstream(path) << yaml;
+  scratch_files.paths.push_back(path);
   return path;
 }
 
@@ -142,7 +155,8 @@ gateway:
 
   const std::string lacking = config_file("lacking", "gateway:\n  ros__parameters:\n    baud: 9600\n");
   Commands refused;
-  EXPECT_NE(refused.parse({"gateway", "--config", lacking}).find("--baud requires --serial"), std::string::npos);
+  EXPECT_NE(refused.parse({"gateway", "--config", lacking}).find("--baud requires --serial"),
+            std::string::npos);
 }
 
 TEST(ConfigFile, AnUnknownKeyIsRefusedNamingItWhicheverCommandReadsTheFile) {
