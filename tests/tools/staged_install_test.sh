@@ -17,15 +17,9 @@ trap 'rm -rf "$work"' EXIT
 fail() { echo "staged_install_test: FAIL: $*" >&2; exit 1; }
 step() { echo "staged_install_test: $*"; }
 
-# A DDS domain id of our own: the lock files tests/support/domain_id.cpp leases (1..200).
-domain=""
-for k in $(seq 0 199); do
-  id=$(( 1 + ($$ + k) % 200 ))
-  exec {lock_fd}>"/tmp/beaconloc-domain-$id.lock"
-  if flock -n "$lock_fd"; then domain=$id; break; fi
-  exec {lock_fd}>&-
-done
-[ -n "$domain" ] || fail "no free DDS domain id in 1..200"
+# A DDS domain id of our own, held until exit.
+. "$(dirname "${BASH_SOURCE[0]}")/domain_lease.sh"
+lease_domain || fail "no free DDS domain id in 1..200"
 
 step "packages (cpack -G DEB)"
 (cd "$work" && cpack -G DEB --config "$build_dir/CPackConfig.cmake" -B "$work/packages" >"$work/cpack.log" 2>&1) ||

@@ -94,15 +94,9 @@ if [ -n "$manager_reason" ]; then
   exit 0
 fi
 
-# A DDS domain id no other test run holds (tests/support/domain_id.cpp's locks), held until exit.
-domain=
-for k in $(seq 0 199); do
-  id=$(( ($$ + k) % 200 + 1 ))
-  exec {lock_fd}>"/tmp/beaconloc-domain-$id.lock" || continue
-  if flock -n "$lock_fd"; then domain=$id; break; fi
-  exec {lock_fd}>&-
-done
-[ -n "$domain" ] || fail "no free DDS domain id in 1..200"
+# A DDS domain id of our own, held until exit.
+. "$(dirname "${BASH_SOURCE[0]}")/domain_lease.sh"
+lease_domain || fail "no free DDS domain id in 1..200"
 
 robot="systemdtest$$"
 etc="$work/etc"
