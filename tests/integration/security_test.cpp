@@ -47,12 +47,13 @@ class Security : public ParticipantsTest {
   }
   // The secured pipeline: a simulated robot1 until stopped, the decoder and the localizer, each
   // with its role's default enclave; returns once the localizer has localized robot1 for 1 s.
-  // Started once more, said on stdout, when the first start gives no pose: Fast DDS 2.9 sometimes
-  // leaves a secured writer-reader pair unmatched or unable to deliver anything (docs/security.md;
-  // a participant that never got the beacon map, a range or pose pair mute), which is not what
-  // these tests are about. A second failure fails.
+  // Started again, said on stdout, when a start gives no pose: Fast DDS 2.9 sometimes leaves a
+  // secured pair of participants unable to deliver anything (docs/security.md; a participant that
+  // never got the beacon map, a range or pose pair mute), which is not what these tests are about.
+  // About 1 start in 8 here, so up to three starts; a third failure fails.
   void start_pipeline(const PoseRecorder& poses) {
     const std::vector<std::string> keys{"--keystore", keystore_};
+    constexpr int kAttempts = 3;
     for (int attempt = 1;; ++attempt) {
       gateway_ = std::make_unique<ChildProcess>(
           command("gateway", {"--keystore", keystore_, "--robot", "robot1", "--duration-s", "0"}),
@@ -68,7 +69,7 @@ class Security : public ParticipantsTest {
         print_report(name, report, std::cout);
         map_lost = map_lost || report.last.message().find("waiting for the beacon map") != std::string::npos;
       }
-      if (attempt == 1) {
+      if (attempt < kAttempts) {
         // Any pair of the pipeline, or the one to this process's pose reader, may be the mute one.
         std::cout << (map_lost ? "a participant never got the beacon map"
                                : "no secured pose reached this process")
@@ -90,16 +91,27 @@ class Security : public ParticipantsTest {
     }
     ParticipantsTest::TearDown();
   }
-  // robot's odometry writer in its partition, once matched to the localizer's reader. Created once
-  // more, said on stdout, when the first never matches in 15 s: Fast DDS 2.9's secured endpoint
-  // matching now and then never completes for a pair (docs/security.md), which is not what these
-  // tests are about.
-  static dds::Writer matched_odometry_writer(dds::Participant& p, const std::string& robot) {
+  // A participant of this process with `options`, and its odometry writer in `robot`'s partition
+  // once matched to the localizer's reader (members in this order: the writer goes first).
+  struct MatchedWriter {
+    std::unique_ptr<dds::Participant> participant;
+    dds::Writer odometry;
+  };
+  // Created once more, participant and all, said on stdout, when the writer never matches in 15 s:
+  // Fast DDS 2.9 now and then never completes a secured pair's matching (docs/security.md), which
+  // is not what these tests are about. A new writer alone was not enough: CI saw it fail twice in a
+  // row with the same participant, whose authentication with the localizer may be what is stuck; a
+  // new participant starts that afresh. Three failures give an empty writer.
+  static MatchedWriter matched_odometry_writer(const dds::DdsOptions& options, const std::string& name,
+                                               const std::string& robot) {
+    constexpr int kAttempts = 3;
     for (int attempt = 1;; ++attempt) {
-      dds::Writer w = p.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, robot);
-      if (dds::wait_for_matched_readers({w}, scaled(std::chrono::seconds(15)))) return w;
-      if (attempt == 2) return dds::Writer();
-      std::cout << "the attacker's writer never matched (Fast DDS 2.9 secured matching): created again\n";
+      MatchedWriter m;
+      m.participant = std::make_unique<dds::Participant>(options, name);
+      m.odometry = m.participant->robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, robot);
+      if (dds::wait_for_matched_readers({m.odometry}, scaled(std::chrono::seconds(15)))) return m;
+      if (attempt == kAttempts) return {};
+      std::cout << "the attacker's writer never matched (Fast DDS 2.9 secured matching): participant created again\n";
     }
   }
   // NaN odometry of `robot`, `count` samples 10 ms apart, written by `writer`.
@@ -210,14 +222,14 @@ TEST_F(Security, AnotherRobotsGatewayCannotGetSamplesIntoThisRobotsEstimate) {
   PoseRecorder poses(secured_);
   DiagnosticsRecorder diagnostics(secured_);
   ASSERT_NO_FATAL_FAILURE(start_pipeline(poses));
-  dds::Participant robot2(as("/beaconloc/gateway/robot2"), "test.robot2_gateway");
+  auto robot2 = matched_odometry_writer(as("/beaconloc/gateway/robot2"), "test.robot2_gateway", "robot2");
+  ASSERT_TRUE(robot2.odometry) << "robot2's writer never matched\n" << localizer_->log();
+  auto& odometry = robot2.odometry;
   // Its permissions grant it robot2's partition only.
-  EXPECT_THROW((void)robot2.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, "robot1"),
+  EXPECT_THROW((void)robot2.participant->robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, "robot1"),
                dds::DdsError);
-  EXPECT_THROW((void)robot2.writer<msg::OdometryPubSubType>(dds::kOdometryTopic), dds::DdsError);
+  EXPECT_THROW((void)robot2.participant->writer<msg::OdometryPubSubType>(dds::kOdometryTopic), dds::DdsError);
   // Its own robot's samples reach the localizer (refused for their NaN: counted): the path is up.
-  auto odometry = matched_odometry_writer(robot2, "robot2");
-  ASSERT_TRUE(odometry) << "robot2's writer never matched\n" << localizer_->log();
   const std::uint64_t delivered = deliver(diagnostics, odometry, "robot2");
   ASSERT_GT(delivered, 0u) << "robot2's gateway never reached the localizer\n" << localizer_->log();
   // In its own partition, samples that say robot1: refused by the reader, counted, never fused.
@@ -318,9 +330,9 @@ TEST_F(Security, TamperedMessagesAreDroppedAndCounted) {
   auto tamper = std::make_shared<TamperingSwitch>();
   dds::DdsOptions o = as("/beaconloc/gateway/robot2");
   o.transport = std::make_shared<TamperingTransportDescriptor>(tamper);
-  dds::Participant robot2(o, "test.tampered");
-  auto odometry = matched_odometry_writer(robot2, "robot2");
-  ASSERT_TRUE(odometry) << "robot2's writer never matched\n" << localizer_->log();
+  auto robot2 = matched_odometry_writer(o, "test.tampered", "robot2");
+  ASSERT_TRUE(robot2.odometry) << "robot2's writer never matched\n" << localizer_->log();
+  auto& odometry = robot2.odometry;
   // Intact, its samples arrive (refused for their NaN: counted).
   const std::uint64_t delivered = deliver(diagnostics, odometry, "robot2");
   ASSERT_GT(delivered, 0u) << "robot2's gateway never reached the localizer\n" << localizer_->log();
