@@ -46,12 +46,14 @@ class Security : public ParticipantsTest {
     return o;
   }
   // The secured pipeline: a simulated robot1 until stopped, the decoder and the localizer, each
-  // with its role's default enclave; returns once the localizer has localized robot1 for 1 s.
-  // Started again, said on stdout, when a start gives no pose: Fast DDS 2.9 sometimes leaves a
+  // with its role's default enclave; returns once the localizer has localized robot1 for 1 s and,
+  // given a test's `diagnostics` reader, once that has heard the decoder and the localizer too (a
+  // count the test reads there as 0 must be one they reported, not one never heard).
+  // Started again, said on stdout, when a start falls short: Fast DDS 2.9 sometimes leaves a
   // secured pair of participants unable to deliver anything (docs/security.md; a participant that
-  // never got the beacon map, a range or pose pair mute), which is not what these tests are about.
-  // About 1 start in 8 here, so up to three starts; a third failure fails.
-  void start_pipeline(const PoseRecorder& poses) {
+  // never got the beacon map, a range, pose or Diagnostics pair mute), which is not what these
+  // tests are about. A few starts in a hundred here, so up to three starts; a third failure fails.
+  void start_pipeline(const PoseRecorder& poses, const DiagnosticsRecorder* diagnostics = nullptr) {
     const std::vector<std::string> keys{"--keystore", keystore_};
     constexpr int kAttempts = 3;
     for (int attempt = 1;; ++attempt) {
@@ -60,28 +62,31 @@ class Security : public ParticipantsTest {
           path("gateway.log"));
       decoder_ = std::make_unique<ChildProcess>(command("decoder", keys), path("decoder.log"));
       localizer_ = std::make_unique<ChildProcess>(command("localizer", keys), path("localizer.log"));
-      if (wait_for_pose_span(poses, "robot1", 1s)) return;
-      // What each participant says of itself, through a reader of this process.
-      DiagnosticsRecorder diagnostics(secured_);
+      const bool localized = wait_for_pose_span(poses, "robot1", 1s);
+      const bool heard =
+          localized && (!diagnostics || wait_until_reporting(*diagnostics, {kDecoder, kRangeEkfLocalizer}, 10s));
+      if (heard) return;
+      // What each participant says of itself, through a new reader of this process.
+      DiagnosticsRecorder reporter(secured_);
       std::this_thread::sleep_for(3s);
       bool map_lost = false;
-      for (const auto& [name, report] : diagnostics.reports()) {
+      for (const auto& [name, report] : reporter.reports()) {
         print_report(name, report, std::cout);
         map_lost = map_lost || report.last.message().find("waiting for the beacon map") != std::string::npos;
       }
+      const char* why = map_lost     ? "a participant never got the beacon map"
+                        : !localized ? "no secured pose reached this process"
+                                     : "the test's Diagnostics reader never heard the decoder and the localizer";
       if (attempt < kAttempts) {
-        // Any pair of the pipeline, or the one to this process's pose reader, may be the mute one.
-        std::cout << (map_lost ? "a participant never got the beacon map"
-                               : "no secured pose reached this process")
-                  << " (Fast DDS 2.9 secured matching): started again\n";
+        // Any pair of the pipeline, or one to this process's readers, may be the mute one.
+        std::cout << why << " (Fast DDS 2.9 secured matching): started again\n";
         for (auto* p : {&gateway_, &decoder_, &localizer_}) {
           ASSERT_NO_FATAL_FAILURE(stop_cleanly(**p, "participant"));
           p->reset();
         }
         continue;
       }
-      FAIL() << "no secured pose of robot1 (" << poses.count() << " poses)\n"
-             << gateway_->log() << decoder_->log() << localizer_->log();
+      FAIL() << why << " (" << poses.count() << " poses)\n" << gateway_->log() << decoder_->log() << localizer_->log();
     }
   }
   void TearDown() override {
@@ -90,29 +95,6 @@ class Security : public ParticipantsTest {
       p->reset();
     }
     ParticipantsTest::TearDown();
-  }
-  // A participant of this process with `options`, and its odometry writer in `robot`'s partition
-  // once matched to the localizer's reader (members in this order: the writer goes first).
-  struct MatchedWriter {
-    std::unique_ptr<dds::Participant> participant;
-    dds::Writer odometry;
-  };
-  // Created once more, participant and all, said on stdout, when the writer never matches in 15 s:
-  // Fast DDS 2.9 now and then never completes a secured pair's matching (docs/security.md), which
-  // is not what these tests are about. A new writer alone was not enough: CI saw it fail twice in a
-  // row with the same participant, whose authentication with the localizer may be what is stuck; a
-  // new participant starts that afresh. Three failures give an empty writer.
-  static MatchedWriter matched_odometry_writer(const dds::DdsOptions& options, const std::string& name,
-                                               const std::string& robot) {
-    constexpr int kAttempts = 3;
-    for (int attempt = 1;; ++attempt) {
-      MatchedWriter m;
-      m.participant = std::make_unique<dds::Participant>(options, name);
-      m.odometry = m.participant->robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, robot);
-      if (dds::wait_for_matched_readers({m.odometry}, scaled(std::chrono::seconds(15)))) return m;
-      if (attempt == kAttempts) return {};
-      std::cout << "the attacker's writer never matched (Fast DDS 2.9 secured matching): participant created again\n";
-    }
   }
   // NaN odometry of `robot`, `count` samples 10 ms apart, written by `writer`.
   void write_nan_odometry(const dds::Writer& writer, const std::string& robot, int count) {
@@ -157,6 +139,36 @@ class Security : public ParticipantsTest {
     if (now == before) return 0;
     return localizer_count(d, kNanOdometry, 0);  // once the samples written in the meantime are counted too
   }
+  // A participant of this process with `options` and its odometry writer in `robot`'s partition,
+  // once what it writes reaches the localizer: `delivered` is then the localizer's count of NaN
+  // odometry (deliver). Members in this order: the writer goes first.
+  struct DeliveringWriter {
+    std::unique_ptr<dds::Participant> participant;
+    dds::Writer odometry;
+    std::uint64_t delivered = 0;
+  };
+  // Created again, participant and all, said on stdout, when the writer never matches in 15 s or,
+  // matched, delivers nothing in 15 s more: Fast DDS 2.9 now and then leaves a secured pair of
+  // participants mute (docs/security.md), which is not what these tests are about. A new writer
+  // alone was not enough (CI saw one never match twice in a row with the same participant); a new
+  // participant starts the authentication and the key exchange afresh. Three failures give an
+  // empty writer, delivered 0.
+  DeliveringWriter delivering_odometry_writer(const DiagnosticsRecorder& d, const dds::DdsOptions& options,
+                                              const std::string& name, const std::string& robot) {
+    constexpr int kAttempts = 3;
+    for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+      DeliveringWriter w;
+      w.participant = std::make_unique<dds::Participant>(options, name);
+      w.odometry = w.participant->robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, robot);
+      const bool matched = dds::wait_for_matched_readers({w.odometry}, scaled(std::chrono::seconds(15)));
+      if (matched) w.delivered = deliver(d, w.odometry, robot);
+      if (w.delivered > 0) return w;
+      std::cout << "the attacker's writer " << (matched ? "never reached the localizer" : "never matched")
+                << " (Fast DDS 2.9 secured matching)" << (attempt < kAttempts ? ": participant created again" : "")
+                << '\n';
+    }
+    return {};
+  }
 
   // An attacker whose own access control lets it write `robot`'s odometry (NaN): never matched,
   // nothing of it counted by the localizer.
@@ -189,7 +201,7 @@ TEST_F(Security, AParticipantWithoutCredentialsReadsNoPoseAndInjectsNothing) {
   DiagnosticsRecorder diagnostics(secured_);
   PoseRecorder outsider_poses(dds_);  // the same domain, no credentials
   DiagnosticsRecorder outsider_diagnostics(dds_);
-  ASSERT_NO_FATAL_FAILURE(start_pipeline(poses));
+  ASSERT_NO_FATAL_FAILURE(start_pipeline(poses, &diagnostics));
   dds::Participant outsider(dds_, "test.outsider");
   auto odometry = outsider.robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, "robot1");
   auto unpartitioned = outsider.writer<msg::OdometryPubSubType>(dds::kOdometryTopic);
@@ -221,17 +233,17 @@ TEST_F(Security, AParticipantWithoutCredentialsReadsNoPoseAndInjectsNothing) {
 TEST_F(Security, AnotherRobotsGatewayCannotGetSamplesIntoThisRobotsEstimate) {
   PoseRecorder poses(secured_);
   DiagnosticsRecorder diagnostics(secured_);
-  ASSERT_NO_FATAL_FAILURE(start_pipeline(poses));
-  auto robot2 = matched_odometry_writer(as("/beaconloc/gateway/robot2"), "test.robot2_gateway", "robot2");
-  ASSERT_TRUE(robot2.odometry) << "robot2's writer never matched\n" << localizer_->log();
+  ASSERT_NO_FATAL_FAILURE(start_pipeline(poses, &diagnostics));
+  // Its own robot's samples reach the localizer (refused for their NaN: counted): the path is up.
+  auto robot2 =
+      delivering_odometry_writer(diagnostics, as("/beaconloc/gateway/robot2"), "test.robot2_gateway", "robot2");
+  ASSERT_GT(robot2.delivered, 0u) << "robot2's gateway never reached the localizer\n" << localizer_->log();
   auto& odometry = robot2.odometry;
+  const std::uint64_t delivered = robot2.delivered;
   // Its permissions grant it robot2's partition only.
   EXPECT_THROW((void)robot2.participant->robot_writer<msg::OdometryPubSubType>(dds::kOdometryTopic, "robot1"),
                dds::DdsError);
   EXPECT_THROW((void)robot2.participant->writer<msg::OdometryPubSubType>(dds::kOdometryTopic), dds::DdsError);
-  // Its own robot's samples reach the localizer (refused for their NaN: counted): the path is up.
-  const std::uint64_t delivered = deliver(diagnostics, odometry, "robot2");
-  ASSERT_GT(delivered, 0u) << "robot2's gateway never reached the localizer\n" << localizer_->log();
   // In its own partition, samples that say robot1: refused by the reader, counted, never fused.
   write_nan_odometry(odometry, "robot1", 20);
   EXPECT_EQ(localizer_count(diagnostics, "sample_for_another_robot", 20), 20u);
@@ -270,7 +282,7 @@ TEST_F(Security, AReadOnlyIdentityCannotPublish) {
 TEST_F(Security, PermissionsNotSignedByTheDeploymentAreRefused) {
   PoseRecorder poses(secured_);
   DiagnosticsRecorder diagnostics(secured_);
-  ASSERT_NO_FATAL_FAILURE(start_pipeline(poses));
+  ASSERT_NO_FATAL_FAILURE(start_pipeline(poses, &diagnostics));
   const std::string forged = path("forged");
   deployment_keys("init " + forged);
   deployment_keys("enclave " + forged + " gateway robot1 --enclave /beaconloc/monitor");
@@ -306,7 +318,7 @@ TEST_F(Security, ARevokedIdentityIsShutOut) {
   old.security.keystore = before;
   PoseRecorder poses(old);
   DiagnosticsRecorder diagnostics(old);
-  ASSERT_NO_FATAL_FAILURE(start_pipeline(poses));  // with the new keystore
+  ASSERT_NO_FATAL_FAILURE(start_pipeline(poses, &diagnostics));  // with the new keystore
   dds::DdsOptions o = as("/beaconloc/gateway/robot2");
   o.security.keystore = before;
   expect_shut_out(o, "robot2", diagnostics);
@@ -326,16 +338,15 @@ TEST_F(Security, AnExpiredIdentityDoesNotStartAndSaysWhy) {
 TEST_F(Security, TamperedMessagesAreDroppedAndCounted) {
   PoseRecorder poses(secured_);
   DiagnosticsRecorder diagnostics(secured_);
-  ASSERT_NO_FATAL_FAILURE(start_pipeline(poses));
+  ASSERT_NO_FATAL_FAILURE(start_pipeline(poses, &diagnostics));
   auto tamper = std::make_shared<TamperingSwitch>();
   dds::DdsOptions o = as("/beaconloc/gateway/robot2");
   o.transport = std::make_shared<TamperingTransportDescriptor>(tamper);
-  auto robot2 = matched_odometry_writer(o, "test.tampered", "robot2");
-  ASSERT_TRUE(robot2.odometry) << "robot2's writer never matched\n" << localizer_->log();
-  auto& odometry = robot2.odometry;
   // Intact, its samples arrive (refused for their NaN: counted).
-  const std::uint64_t delivered = deliver(diagnostics, odometry, "robot2");
-  ASSERT_GT(delivered, 0u) << "robot2's gateway never reached the localizer\n" << localizer_->log();
+  auto robot2 = delivering_odometry_writer(diagnostics, o, "test.tampered", "robot2");
+  ASSERT_GT(robot2.delivered, 0u) << "robot2's gateway never reached the localizer\n" << localizer_->log();
+  const auto& odometry = robot2.odometry;
+  const std::uint64_t delivered = robot2.delivered;
   EXPECT_EQ(localizer_count(diagnostics, "undecodable_secure_message", 0, 0ms), 0u);
   tamper->on = true;
   write_nan_odometry(odometry, "robot2", 20);
